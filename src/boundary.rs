@@ -1,0 +1,153 @@
+//! Walls: the seed's reflection rules in vector form ([`reflect_off_walls`], a plain function)
+//! and [`WallsPlugin`], which applies them in [`CircleSystems::Boundary`].
+//!
+//! Per axis: a circle whose edge is past a wall and that moves outward is mirrored back inside
+//! and its normal velocity flipped; one that is past a wall but already moving inward (pushed
+//! there by a collision) is only put back, so it cannot be flipped twice and stick to the wall.
+
+use bevy::prelude::*;
+
+use crate::components::{Position, Radius, Velocity};
+use crate::config::Arena;
+use crate::diagnostics::CollisionCounters;
+use crate::schedule::{CircleStep, CircleSystems};
+
+/// Keeps every circle inside the [`Arena`] by reflecting it off the walls.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WallsPlugin;
+
+impl Plugin for WallsPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(CircleStep, bounce_off_walls.in_set(CircleSystems::Boundary));
+    }
+}
+
+/// Reflects one circle off the walls of `arena`; returns how many wall hits that took.
+///
+/// A circle that overshot by several arena widths in one step (a huge speed or `dt`) is folded
+/// back exactly as if it had bounced each time, so it always ends inside. A circle wider than
+/// the arena on an axis is centred on that axis and its velocity there zeroed: it cannot move.
+pub fn reflect_off_walls(
+    position: &mut Vec2,
+    velocity: &mut Vec2,
+    radius: f32,
+    arena: &Arena,
+) -> u32 {
+    let mut hits = 0;
+    for axis in 0..2 {
+        let lo = arena.min[axis] + radius;
+        let hi = arena.max[axis] - radius;
+        hits += reflect_axis(&mut position[axis], &mut velocity[axis], lo, hi);
+    }
+    hits
+}
+
+fn reflect_axis(p: &mut f32, v: &mut f32, lo: f32, hi: f32) -> u32 {
+    if *p >= lo && *p <= hi {
+        return 0;
+    }
+    let span = hi - lo;
+    if span <= 0.0 {
+        *p = 0.5 * (lo + hi);
+        *v = 0.0;
+        return 0;
+    }
+    let moving_out = (*p < lo && *v < 0.0) || (*p > hi && *v > 0.0);
+    if !moving_out {
+        *p = p.clamp(lo, hi);
+        return 0;
+    }
+    // Unfold the motion onto a line of mirrored copies of [lo, hi]: the distance past `lo`
+    // modulo two spans says where the circle is and which way it now moves.
+    let unfolded = *p - lo;
+    let period = 2.0 * span;
+    let m = unfolded.rem_euclid(period);
+    let spans = unfolded / span;
+    let crossings = if spans < 0.0 {
+        (-spans).ceil()
+    } else {
+        spans.floor()
+    } as u32;
+    let (folded, flipped) = if m <= span {
+        (m, false)
+    } else {
+        (period - m, true)
+    };
+    // rem_euclid can round up to `period`; clamp keeps the result inside even then.
+    *p = (lo + folded).clamp(lo, hi);
+    if flipped {
+        *v = -*v;
+    }
+    crossings.max(1)
+}
+
+/// Applies [`reflect_off_walls`] to every circle and counts the hits.
+pub fn bounce_off_walls(
+    arena: Res<Arena>,
+    mut counters: ResMut<CollisionCounters>,
+    mut circles: Query<(&mut Position, &mut Velocity, &Radius)>,
+) {
+    let mut hits = 0u64;
+    for (mut position, mut velocity, radius) in &mut circles {
+        let (mut p, mut v) = (position.0, velocity.0);
+        let n = reflect_off_walls(&mut p, &mut v, radius.0, &arena);
+        if n > 0 || p != position.0 {
+            position.0 = p;
+            velocity.0 = v;
+            hits += u64::from(n);
+        }
+    }
+    counters.wall_collisions += hits;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit() -> Arena {
+        Arena {
+            min: Vec2::ZERO,
+            max: Vec2::ONE,
+        }
+    }
+
+    #[test]
+    fn overshoot_is_mirrored_and_velocity_flipped() {
+        let (mut p, mut v) = (Vec2::new(1.05, 0.5), Vec2::new(1.0, 0.2));
+        let hits = reflect_off_walls(&mut p, &mut v, 0.1, &unit());
+        assert_eq!(hits, 1);
+        assert!((p.x - 0.75).abs() < 1e-6, "{p}");
+        assert_eq!(v, Vec2::new(-1.0, 0.2));
+    }
+
+    #[test]
+    fn a_circle_already_moving_inward_is_put_back_not_flipped() {
+        let (mut p, mut v) = (Vec2::new(0.05, 0.5), Vec2::new(0.3, 0.0));
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 0);
+        assert_eq!(p, Vec2::new(0.1, 0.5));
+        assert_eq!(v, Vec2::new(0.3, 0.0));
+    }
+
+    #[test]
+    fn many_arena_widths_in_one_step_fold_back_inside() {
+        // lo = 0.1, hi = 0.9, span 0.8: 3.3 past lo is 4 wall hits (even: same direction)
+        // and 0.1 into the fifth span.
+        let (mut p, mut v) = (Vec2::new(3.4, 0.5), Vec2::new(5.0, 0.0));
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 4);
+        assert!((p.x - 0.2).abs() < 1e-5, "{p}");
+        assert_eq!(v.x, 5.0);
+        // 0.9 + 0.5 past hi: one hit, mirrored to 0.4, moving back.
+        let (mut p, mut v) = (Vec2::new(1.4, 0.5), Vec2::new(5.0, 0.0));
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 1);
+        assert!((p.x - 0.4).abs() < 1e-5, "{p}");
+        assert_eq!(v.x, -5.0);
+        // Past the low wall, moving out: one hit.
+        let (mut p, mut v) = (Vec2::new(-0.1, 0.5), Vec2::new(-5.0, 0.0));
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 1);
+        assert!((p.x - 0.3).abs() < 1e-5, "{p}");
+        assert_eq!(v.x, 5.0);
+        let (mut p, mut v) = (Vec2::new(-1e7, 0.5), Vec2::new(-1e9, 0.0));
+        reflect_off_walls(&mut p, &mut v, 0.1, &unit());
+        assert!(unit().contains(p) && p.is_finite());
+    }
+}

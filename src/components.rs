@@ -1,0 +1,70 @@
+//! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass` and `Tint`.
+//!
+//! `Position` is deliberately not `Transform`: the simulation owns it, and the render side copies
+//! it into `Transform` only when rendering is on. Inserting a [`Radius`] is what makes an entity a
+//! circle; it brings the other components with it (`#[require]`), so
+//! `commands.spawn((Radius(0.5), Position(Vec2::ZERO)))` is a complete, resting, unit-mass circle.
+
+use bevy::prelude::*;
+
+/// Centre of a circle in arena coordinates.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Default, Debug)]
+pub struct Position(pub Vec2);
+
+/// Linear velocity in arena units per second.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Default, Debug)]
+pub struct Velocity(pub Vec2);
+
+/// Radius of a circle. Must be finite and positive; inserting it makes the entity a circle.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Debug)]
+#[require(Position, Velocity, Mass, Tint)]
+pub struct Radius(pub f32);
+
+/// Mass of a circle. `f32::INFINITY` makes a circle immovable (its inverse mass is zero).
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Default, Debug)]
+pub struct Mass(pub f32);
+
+impl Default for Mass {
+    fn default() -> Self {
+        Self(1.0)
+    }
+}
+
+impl Mass {
+    /// `1 / mass`, zero for an infinite mass. Collision kernels work with inverse masses so that
+    /// immovable circles need no special case.
+    pub fn inverse(self) -> f32 {
+        if self.0.is_finite() {
+            1.0 / self.0
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Display colour of a circle as sRGB bytes, as in the plain-text particle format (`r g b`).
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Eq, Deref, DerefMut)]
+#[reflect(Component, Default, Debug)]
+pub struct Tint(pub [u8; 3]);
+
+impl Default for Tint {
+    fn default() -> Self {
+        Self([230, 230, 230])
+    }
+}
+
+impl From<Vec2> for Position {
+    fn from(v: Vec2) -> Self {
+        Self(v)
+    }
+}
+
+impl From<Vec2> for Velocity {
+    fn from(v: Vec2) -> Self {
+        Self(v)
+    }
+}

@@ -1,0 +1,257 @@
+//! Plain configuration structs for the plugin group: the arena, spawning, the solver and the
+//! effects a scene calls for. Each is a `Resource` once the plugins are added, so systems and
+//! users read (and change) the live settings in one place.
+
+use std::fmt;
+use std::str::FromStr;
+
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// The axis-aligned rectangle the circles live in, bounded by walls.
+#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[reflect(Resource, Debug)]
+pub struct Arena {
+    /// Lower-left corner.
+    pub min: Vec2,
+    /// Upper-right corner.
+    pub max: Vec2,
+}
+
+impl Default for Arena {
+    /// A 16:9 arena, 16 units wide, centred on the origin (the seed's window shape).
+    fn default() -> Self {
+        Self::centered(Vec2::new(16.0, 9.0))
+    }
+}
+
+impl Arena {
+    /// An arena of the given size centred on the origin.
+    pub fn centered(size: Vec2) -> Self {
+        Self {
+            min: -size / 2.0,
+            max: size / 2.0,
+        }
+    }
+
+    /// Width and height.
+    pub fn size(&self) -> Vec2 {
+        self.max - self.min
+    }
+
+    /// Area of the arena.
+    pub fn area(&self) -> f32 {
+        let s = self.size();
+        s.x * s.y
+    }
+
+    /// Centre of the arena.
+    pub fn center(&self) -> Vec2 {
+        (self.min + self.max) / 2.0
+    }
+
+    /// Whether a point lies inside or on the boundary.
+    pub fn contains(&self, p: Vec2) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
+}
+
+/// How a spawned circle's mass is chosen.
+#[derive(Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum MassModel {
+    /// Mass proportional to area: `density · π r²`.
+    Area {
+        /// Mass per unit area.
+        density: f32,
+    },
+    /// Every circle has this mass (the seed's assumption).
+    Equal(f32),
+}
+
+impl Default for MassModel {
+    fn default() -> Self {
+        Self::Area { density: 1.0 }
+    }
+}
+
+impl MassModel {
+    /// The mass of a circle of radius `r` under this model.
+    pub fn mass_of(self, r: f32) -> f32 {
+        match self {
+            Self::Area { density } => density * std::f32::consts::PI * r * r,
+            Self::Equal(m) => m,
+        }
+    }
+}
+
+/// Random placement of circles: how many, how big, how fast. Seeded and reproducible.
+#[derive(Resource, Reflect, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[reflect(Resource, Debug)]
+pub struct SpawnConfig {
+    /// How many circles to place.
+    pub count: usize,
+    /// Smallest and largest radius; radii are drawn uniformly in between.
+    pub radius: (f32, f32),
+    /// Smallest and largest speed; directions are uniform.
+    pub speed: (f32, f32),
+    /// Seed of the random generator: the same seed gives the same circles.
+    pub seed: u64,
+    /// How masses are assigned.
+    pub mass: MassModel,
+    /// Placement attempts per circle before it is given up as not fitting.
+    pub attempts_per_circle: u32,
+}
+
+impl Default for SpawnConfig {
+    /// The seed exercise: 32 circles of random radius, speed and direction.
+    fn default() -> Self {
+        Self {
+            count: 32,
+            radius: (0.2, 0.6),
+            speed: (1.0, 4.0),
+            seed: 1,
+            mass: MassModel::default(),
+            attempts_per_circle: 200,
+        }
+    }
+}
+
+/// How one fixed step of simulated time is advanced.
+#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[reflect(Resource, Debug)]
+pub enum Solver {
+    /// Move, then push overlapping pairs apart and apply the elastic impulse (the seed's method).
+    #[default]
+    Discrete,
+    /// `Discrete` run `N` times per step with `dt / N`.
+    Substeps(u32),
+}
+
+impl Solver {
+    /// How many times the step schedule runs per fixed step.
+    pub fn substeps(self) -> u32 {
+        match self {
+            Self::Discrete => 1,
+            Self::Substeps(n) => n.max(1),
+        }
+    }
+}
+
+impl fmt::Display for Solver {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Discrete => write!(f, "discrete"),
+            Self::Substeps(n) => write!(f, "substeps={n}"),
+        }
+    }
+}
+
+/// Why a solver name could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown solver `{0}`: expected `discrete` or `substeps=N` with N from 1 to 1024")]
+pub struct ParseSolverError(pub String);
+
+impl FromStr for Solver {
+    type Err = ParseSolverError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let err = || ParseSolverError(s.to_owned());
+        match s.trim() {
+            "discrete" => Ok(Self::Discrete),
+            other => {
+                let n = other.strip_prefix("substeps=").ok_or_else(err)?;
+                match n.parse::<u32>() {
+                    Ok(n @ 1..=1024) => Ok(Self::Substeps(n)),
+                    _ => Err(err()),
+                }
+            }
+        }
+    }
+}
+
+impl Serialize for Solver {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> Deserialize<'de> for Solver {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+/// The effects a scene calls for. Only these get systems in the schedule.
+#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[reflect(Resource, Debug)]
+pub struct Effects {
+    /// Circle-circle collisions (broad phase, separation and impulse).
+    pub collisions: bool,
+    /// Coefficient of restitution between circles: 1 is perfectly elastic.
+    pub restitution: f32,
+}
+
+impl Default for Effects {
+    fn default() -> Self {
+        Self {
+            collisions: true,
+            restitution: 1.0,
+        }
+    }
+}
+
+/// Everything [`CirclesPlugins`](crate::CirclesPlugins) needs, in one value.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CirclesConfig {
+    /// The walls.
+    pub arena: Arena,
+    /// Random initial circles.
+    pub spawn: SpawnConfig,
+    /// How a step is advanced.
+    pub solver: Solver,
+    /// What is simulated.
+    pub effects: Effects,
+    /// The fixed step in seconds.
+    pub dt: f64,
+}
+
+impl Default for CirclesConfig {
+    /// The seed: a 16:9 arena with 32 random circles, stepped at 60 Hz.
+    fn default() -> Self {
+        Self {
+            arena: Arena::default(),
+            spawn: SpawnConfig::default(),
+            solver: Solver::default(),
+            effects: Effects::default(),
+            dt: 1.0 / 60.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solver_names_round_trip() {
+        for s in [Solver::Discrete, Solver::Substeps(1), Solver::Substeps(16)] {
+            assert_eq!(s.to_string().parse::<Solver>(), Ok(s));
+        }
+    }
+
+    #[test]
+    fn bad_solver_names_are_rejected_with_the_name() {
+        for bad in [
+            "",
+            "Discrete",
+            "substeps=0",
+            "substeps=x",
+            "substeps=5000",
+            "exacts",
+        ] {
+            let err = bad.parse::<Solver>().unwrap_err();
+            assert!(err.to_string().contains(&format!("`{bad}`")), "{err}");
+        }
+    }
+}

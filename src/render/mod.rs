@@ -1,0 +1,182 @@
+//! The windowed app's side (cargo feature `render`): a camera that keeps the whole arena in view
+//! at its aspect ratio, one sprite per circle sharing a single disc texture (so thousands draw
+//! in a handful of batched draw calls, each with its own tint), and the [`hud`], [`input`] and
+//! [`screenshot`] plugins. The simulation never reads anything from here: `Position` is copied
+//! into `Transform` once per frame, after the fixed steps.
+
+pub mod hud;
+pub mod input;
+pub mod screenshot;
+
+use bevy::asset::RenderAssetUsages;
+use bevy::camera::ScalingMode;
+use bevy::prelude::*;
+use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+
+use crate::components::{Position, Radius, Tint};
+use crate::config::Arena;
+
+/// Everything the window shows: arena, circles, HUD and the keyboard and mouse controls.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CirclesRenderPlugin;
+
+impl Plugin for CirclesRenderPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(ClearColor(Color::srgb(0.02, 0.02, 0.03)))
+            .add_plugins((hud::HudPlugin, input::InputPlugin))
+            .add_systems(Startup, (create_disc_texture, spawn_camera_and_arena))
+            .add_systems(
+                PostUpdate,
+                (attach_sprites, sync_transforms)
+                    .chain()
+                    .before(TransformSystems::Propagate),
+            );
+    }
+}
+
+/// The one texture every circle sprite shares: a white anti-aliased disc, tinted per circle.
+#[derive(Resource, Clone, Debug)]
+pub struct DiscTexture(pub Handle<Image>);
+
+/// Marks the backdrop sprite that shows the arena.
+#[derive(Component, Clone, Copy, Debug)]
+pub struct ArenaBackdrop;
+
+const DISC_PIXELS: u32 = 128;
+
+fn create_disc_texture(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
+    let size = DISC_PIXELS as f32;
+    let radius = size / 2.0;
+    let mut data = Vec::with_capacity((DISC_PIXELS * DISC_PIXELS * 4) as usize);
+    for y in 0..DISC_PIXELS {
+        for x in 0..DISC_PIXELS {
+            let d = Vec2::new(x as f32 + 0.5 - radius, y as f32 + 0.5 - radius).length();
+            // One pixel of soft edge; coverage in alpha, colour white so `Sprite::color` tints it.
+            let alpha = (radius - d).clamp(0.0, 1.0);
+            data.extend_from_slice(&[255, 255, 255, (alpha * 255.0) as u8]);
+        }
+    }
+    let image = Image::new(
+        Extent3d {
+            width: DISC_PIXELS,
+            height: DISC_PIXELS,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        data,
+        TextureFormat::Rgba8UnormSrgb,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    commands.insert_resource(DiscTexture(images.add(image)));
+}
+
+/// Margin around the arena, as a fraction of its size, so the walls are visible.
+const VIEW_MARGIN: f32 = 1.04;
+/// Extra room above the arena for the HUD line, as a fraction of the arena height.
+const HUD_BAND: f32 = 0.07;
+
+fn spawn_camera_and_arena(mut commands: Commands, arena: Res<Arena>) {
+    let size = arena.size();
+    commands.spawn((
+        Camera2d,
+        Projection::Orthographic(OrthographicProjection {
+            // AutoMin keeps the whole arena visible at its own aspect ratio whatever the window.
+            scaling_mode: ScalingMode::AutoMin {
+                min_width: size.x * VIEW_MARGIN,
+                min_height: size.y * (VIEW_MARGIN + HUD_BAND),
+            },
+            ..OrthographicProjection::default_2d()
+        }),
+        // Shift the view up by half the HUD band so the band sits above the arena.
+        Transform::from_translation(
+            (arena.center() + Vec2::Y * size.y * HUD_BAND / 2.0).extend(0.0),
+        ),
+    ));
+    commands.spawn((
+        ArenaBackdrop,
+        Sprite {
+            color: Color::srgb(0.09, 0.1, 0.14),
+            custom_size: Some(size),
+            ..default()
+        },
+        Transform::from_translation(arena.center().extend(-1.0)),
+    ));
+}
+
+/// Gives every new circle its sprite.
+fn attach_sprites(
+    mut commands: Commands,
+    disc: Option<Res<DiscTexture>>,
+    new_circles: Query<(Entity, &Position, &Radius, &Tint), Without<Sprite>>,
+) {
+    let Some(disc) = disc else { return };
+    for (entity, position, radius, tint) in &new_circles {
+        let [r, g, b] = tint.0;
+        commands.entity(entity).insert((
+            Sprite {
+                image: disc.0.clone(),
+                color: Color::srgb_u8(r, g, b),
+                custom_size: Some(Vec2::splat(2.0 * radius.0)),
+                ..default()
+            },
+            Transform::from_translation(position.0.extend(0.0)),
+        ));
+    }
+}
+
+/// Copies the simulation's `Position` (and any changed `Radius`) into what the renderer reads.
+fn sync_transforms(
+    mut circles: Query<(&Position, Ref<Radius>, &mut Transform, &mut Sprite), Changed<Position>>,
+) {
+    circles
+        .par_iter_mut()
+        .for_each(|(position, radius, mut transform, mut sprite)| {
+            transform.translation = position.0.extend(0.0);
+            if radius.is_changed() {
+                sprite.custom_size = Some(Vec2::splat(2.0 * radius.0));
+            }
+        });
+}
+
+/// Why the window cannot open here, if that can be told before trying: no X display (the app is
+/// built for X11 only, which Wayland desktops provide through XWayland).
+pub fn display_problem() -> Option<String> {
+    let display = std::env::var_os("DISPLAY").is_some_and(|v| !v.is_empty());
+    if cfg!(target_os = "linux") && !display {
+        Some(NO_WINDOW_HINT.to_owned())
+    } else {
+        None
+    }
+}
+
+/// What to tell a user whose machine cannot open the window.
+pub const NO_WINDOW_HINT: &str = "moving_circles: cannot open a window here (no display, or no \
+Vulkan/GL driver). Use the headless commands instead (`moving_circles run --help`), or run the \
+app under a virtual display: `xvfb-run -a moving_circles` (Debian packages: xvfb, xauth, \
+mesa-vulkan-drivers).";
+
+/// The complete windowed app: Bevy's default plugins (as far as the enabled features go), the
+/// simulation, drawing, HUD and controls; with `screenshot = Some((path, frames))` it renders
+/// `frames` frames, saves the window and exits.
+pub fn app(
+    config: crate::config::CirclesConfig,
+    screenshot: Option<(std::path::PathBuf, u32)>,
+) -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        DefaultPlugins.set(WindowPlugin {
+            primary_window: Some(Window {
+                title: "moving circles".into(),
+                resolution: (1280, 720).into(),
+                ..default()
+            }),
+            ..default()
+        }),
+        crate::CirclesPlugins::new(config),
+        CirclesRenderPlugin,
+    ));
+    if let Some((path, frames)) = screenshot {
+        app.add_plugins(screenshot::ScreenshotPlugin { path, frames });
+    }
+    app
+}

@@ -1,0 +1,138 @@
+//! When things run: the public [`CircleSystems`] sets, the [`CircleStep`] schedule that one
+//! (sub)step of the solver runs, and [`StepPlugin`], the core plugin every other plugin builds on.
+//!
+//! Data flow per fixed step (in `FixedUpdate`):
+//! `CircleSystems::Step` runs [`CircleStep`] `substeps` times with `dt / substeps`
+//! (`Integrate` → `Boundary` → `Collide`), then `CircleSystems::Diagnostics` measures the result.
+//! Spawning happens outside the fixed clock (`Startup` and `PreUpdate`, set `CircleSystems::Spawn`)
+//! so a paused simulation can still be reset.
+
+use std::time::Duration;
+
+use bevy::ecs::schedule::ScheduleLabel;
+use bevy::prelude::*;
+
+use crate::config::{Arena, Solver};
+use crate::diagnostics::CollisionCounters;
+
+/// The system sets of the simulation, in the order they run.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CircleSystems {
+    /// Placing circles (`Startup`, and `PreUpdate` for respawn requests).
+    Spawn,
+    /// Advancing one fixed step: runs [`CircleStep`] (`FixedUpdate`).
+    Step,
+    /// Moving circles over the step's `dt` (inside [`CircleStep`]).
+    Integrate,
+    /// Keeping circles inside the arena (inside [`CircleStep`]).
+    Boundary,
+    /// Resolving circle-circle contacts (inside [`CircleStep`]).
+    Collide,
+    /// Measuring energy, momentum and collision rates after the step (`FixedUpdate`).
+    Diagnostics,
+}
+
+/// The schedule of one solver substep. Run by [`run_circle_step`] once per substep.
+#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CircleStep;
+
+/// The simulated time one run of [`CircleStep`] covers, in seconds (`dt / substeps`).
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
+pub struct StepDt(pub f32);
+
+/// The core plugin: inserts the arena and solver, sets the fixed clock, builds [`CircleStep`]
+/// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
+#[derive(Clone, Debug)]
+pub struct StepPlugin {
+    /// The arena the circles live in.
+    pub arena: Arena,
+    /// How a fixed step is advanced.
+    pub solver: Solver,
+    /// The fixed step in seconds.
+    pub dt: f64,
+}
+
+impl Default for StepPlugin {
+    fn default() -> Self {
+        Self {
+            arena: Arena::default(),
+            solver: Solver::default(),
+            dt: 1.0 / 60.0,
+        }
+    }
+}
+
+impl Plugin for StepPlugin {
+    fn build(&self, app: &mut App) {
+        app.register_type::<Arena>()
+            .register_type::<Solver>()
+            .insert_resource(self.arena)
+            .insert_resource(self.solver)
+            .insert_resource(Time::<Fixed>::from_duration(Duration::from_secs_f64(
+                self.dt,
+            )))
+            .init_resource::<StepDt>()
+            .init_resource::<CollisionCounters>()
+            .init_schedule(CircleStep)
+            .configure_sets(
+                CircleStep,
+                (
+                    CircleSystems::Integrate,
+                    CircleSystems::Boundary,
+                    CircleSystems::Collide,
+                )
+                    .chain(),
+            )
+            .configure_sets(
+                FixedUpdate,
+                (CircleSystems::Step, CircleSystems::Diagnostics).chain(),
+            )
+            .add_systems(FixedUpdate, run_circle_step.in_set(CircleSystems::Step));
+    }
+}
+
+/// Advances one fixed step: runs [`CircleStep`] once per substep with the substep's `dt`.
+pub fn run_circle_step(world: &mut World) {
+    let substeps = world.resource::<Solver>().substeps();
+    let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
+    world.resource_mut::<StepDt>().0 = (dt / f64::from(substeps)) as f32;
+    for _ in 0..substeps {
+        world.run_schedule(CircleStep);
+    }
+    world.resource_mut::<CollisionCounters>().steps += 1;
+}
+
+/// The schedules the simulation adds systems to, in the order a frame meets them.
+pub const SIMULATION_SCHEDULES: [&str; 4] = ["Startup", "PreUpdate", "FixedUpdate", "CircleStep"];
+
+/// The simulation's systems, as `(schedule, system)` names in execution order, for every
+/// schedule in [`SIMULATION_SCHEDULES`]. Only this crate's systems are listed. Initializes the
+/// schedules it looks at (harmless: Bevy would on first run).
+pub fn scheduled_systems(app: &mut App) -> Vec<(String, String)> {
+    let world = app.world_mut();
+    let labels: Vec<_> = world
+        .resource::<Schedules>()
+        .iter()
+        .map(|(_, schedule)| schedule.label())
+        .filter(|label| SIMULATION_SCHEDULES.contains(&format!("{label:?}").as_str()))
+        .collect();
+    let mut listed = Vec::new();
+    for name in SIMULATION_SCHEDULES {
+        let Some(&label) = labels.iter().find(|l| format!("{l:?}") == name) else {
+            continue;
+        };
+        world.schedule_scope(label, |world, schedule| {
+            if let Err(e) = schedule.initialize(world) {
+                panic!("schedule {name} does not build: {e}");
+            }
+            let systems = schedule.systems().expect("initialized above");
+            for (_, system) in systems {
+                let system_name = system.name().to_string();
+                if system_name.starts_with(concat!(env!("CARGO_CRATE_NAME"), "::")) {
+                    listed.push((name.to_owned(), system_name));
+                }
+            }
+        });
+    }
+    listed
+}

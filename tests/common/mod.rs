@@ -1,0 +1,114 @@
+//! Shared helpers for the headless system tests: a `MinimalPlugins` app stepped one fixed step
+//! per `update()`, and assertion helpers that say what was expected.
+#![allow(dead_code)] // each test file uses its own subset
+
+use std::hash::{DefaultHasher, Hash, Hasher};
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use moving_circles::prelude::*;
+
+/// A headless app running `config`, already past `Startup` (circles spawned), in which every
+/// `update()` advances exactly one fixed step.
+pub fn create_app(config: CirclesConfig) -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, CirclesPlugins::new(config)))
+        .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
+    app.finish();
+    app.cleanup();
+    app.update();
+    app
+}
+
+/// A config with no random circles, so a test can place its own.
+pub fn empty(config: CirclesConfig) -> CirclesConfig {
+    CirclesConfig {
+        spawn: SpawnConfig {
+            count: 0,
+            ..config.spawn
+        },
+        ..config
+    }
+}
+
+/// Runs `n` fixed steps and checks the app really advanced that many.
+pub fn step(app: &mut App, n: u64) {
+    let before = app.world().resource::<CollisionCounters>().steps;
+    for _ in 0..n {
+        app.update();
+    }
+    let after = app.world().resource::<CollisionCounters>().steps;
+    assert_eq!(
+        after - before,
+        n,
+        "expected {n} fixed steps, the app ran {}",
+        after - before
+    );
+}
+
+/// Spawns one circle.
+pub fn spawn_circle(
+    app: &mut App,
+    position: Vec2,
+    velocity: Vec2,
+    radius: f32,
+    mass: f32,
+) -> Entity {
+    app.world_mut()
+        .spawn((
+            Radius(radius),
+            Position(position),
+            Velocity(velocity),
+            Mass(mass),
+        ))
+        .id()
+}
+
+/// `(position, velocity)` of a circle.
+pub fn state(app: &App, entity: Entity) -> (Vec2, Vec2) {
+    let e = app.world().entity(entity);
+    (
+        e.get::<Position>().unwrap().0,
+        e.get::<Velocity>().unwrap().0,
+    )
+}
+
+/// Every circle as `(position, velocity, radius, mass)`, in query order.
+pub fn circles(app: &mut App) -> Vec<(Vec2, Vec2, f32, f32)> {
+    app.world_mut()
+        .query::<(&Position, &Velocity, &Radius, &Mass)>()
+        .iter(app.world())
+        .map(|(p, v, r, m)| (p.0, v.0, r.0, m.0))
+        .collect()
+}
+
+/// A hash of the exact bits of every position and velocity.
+pub fn state_hash(app: &mut App) -> u64 {
+    let mut hasher = DefaultHasher::new();
+    for (p, v, r, m) in circles(app) {
+        for x in [p.x, p.y, v.x, v.y, r, m] {
+            x.to_bits().hash(&mut hasher);
+        }
+    }
+    hasher.finish()
+}
+
+/// Kinetic energy and momentum, summed in f64.
+pub fn energy_momentum(app: &mut App) -> (f64, DVec2) {
+    circles(app)
+        .iter()
+        .fold((0.0, DVec2::ZERO), |(e, p), &(_, v, _, m)| {
+            let (v, m) = (v.as_dvec2(), f64::from(m));
+            (e + 0.5 * m * v.length_squared(), p + m * v)
+        })
+}
+
+/// Asserts `|actual - expected| <= tolerance · max(|expected|, 1e-12)`, saying what differed.
+pub fn assert_relative(what: &str, actual: f64, expected: f64, tolerance: f64) {
+    let error = (actual - expected).abs() / expected.abs().max(1e-12);
+    assert!(
+        error <= tolerance,
+        "{what}: expected {expected}, got {actual} (relative error {error:e} > {tolerance:e})"
+    );
+}

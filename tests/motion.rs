@@ -1,0 +1,67 @@
+//! Free flight and walls: a lone circle moves exactly `v·dt` per step; a wall hit reflects it and
+//! it never leaves the arena.
+
+mod common;
+
+use bevy::prelude::*;
+use common::*;
+use moving_circles::prelude::*;
+
+#[test]
+fn a_lone_circle_moves_exactly_v_dt_per_step() {
+    let mut app = create_app(empty(CirclesConfig::default()));
+    let v = Vec2::new(1.25, -0.5);
+    let circle = spawn_circle(&mut app, Vec2::new(-1.0, 0.5), v, 0.3, 1.0);
+    let dt = (1.0f64 / 60.0) as f32;
+    let mut expected = Vec2::new(-1.0, 0.5);
+    for _ in 0..60 {
+        step(&mut app, 1);
+        expected += v * dt;
+        let (p, vel) = state(&app, circle);
+        assert_eq!(p, expected, "position after one more step of dt = {dt}");
+        assert_eq!(vel, v, "free flight must not change velocity");
+    }
+}
+
+#[test]
+fn substeps_cover_the_same_time() {
+    let config = CirclesConfig {
+        solver: Solver::Substeps(4),
+        ..empty(CirclesConfig::default())
+    };
+    let mut app = create_app(config);
+    let circle = spawn_circle(&mut app, Vec2::ZERO, Vec2::new(2.0, 0.0), 0.3, 1.0);
+    step(&mut app, 30);
+    let (p, _) = state(&app, circle);
+    // 4 × 30 additions of 2 · dt/4 in f32: half a second of flight, up to rounding.
+    assert!(
+        (p.x - 1.0).abs() < 1e-5,
+        "expected x = 1.0 after 0.5 s, got {}",
+        p.x
+    );
+}
+
+#[test]
+fn a_wall_hit_reflects_and_stays_inside() {
+    let arena = Arena::default();
+    let mut app = create_app(empty(CirclesConfig::default()));
+    let r = 0.4;
+    let v = Vec2::new(6.0, 1.5);
+    let circle = spawn_circle(&mut app, Vec2::new(arena.max.x - 1.0, 0.0), v, r, 1.0);
+    let mut reflected = false;
+    for _ in 0..600 {
+        step(&mut app, 1);
+        let (p, vel) = state(&app, circle);
+        assert!(
+            p.x - r >= arena.min.x
+                && p.x + r <= arena.max.x
+                && p.y - r >= arena.min.y
+                && p.y + r <= arena.max.y,
+            "circle left the arena: centre {p}, radius {r}"
+        );
+        assert_eq!(vel.abs(), v.abs(), "walls only flip velocity components");
+        reflected |= vel.x < 0.0;
+    }
+    assert!(reflected, "the circle never bounced off the right wall");
+    assert!(app.world().resource::<CollisionCounters>().wall_collisions > 0);
+}

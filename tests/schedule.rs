@@ -1,0 +1,133 @@
+//! The schedule: no ambiguous system order, only the plugins a config calls for, and parts can be
+//! disabled the Bevy way.
+
+mod common;
+
+use bevy::app::PluginGroup;
+use bevy::ecs::schedule::{LogLevel, ScheduleBuildSettings};
+use bevy::prelude::*;
+use common::*;
+use moving_circles::prelude::*;
+use moving_circles::schedule::scheduled_systems;
+
+fn system_names(app: &mut App) -> Vec<String> {
+    scheduled_systems(app).into_iter().map(|(_, s)| s).collect()
+}
+
+#[test]
+fn the_schedule_has_no_ambiguities() {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, CirclesPlugins::default()));
+    app.finish();
+    app.cleanup();
+    let world = app.world_mut();
+    let labels: Vec<_> = world
+        .resource::<Schedules>()
+        .iter()
+        .map(|(_, s)| s.label())
+        .collect();
+    let mut conflicts = Vec::new();
+    for label in labels {
+        world.schedule_scope(label, |world, schedule| {
+            schedule.set_build_settings(ScheduleBuildSettings {
+                ambiguity_detection: LogLevel::Warn,
+                ..default()
+            });
+            schedule.initialize(world).expect("schedule builds");
+            let n = schedule.graph().conflicting_systems().len();
+            if n > 0 {
+                conflicts.push(format!("{label:?}: {n}"));
+            }
+        });
+    }
+    assert!(
+        conflicts.is_empty(),
+        "ambiguous system pairs in: {conflicts:?}"
+    );
+}
+
+#[test]
+fn the_default_schedule_runs_the_four_systems_of_the_seed_in_order() {
+    let mut app = create_app(CirclesConfig::default());
+    let step: Vec<_> = scheduled_systems(&mut app)
+        .into_iter()
+        .filter(|(schedule, _)| schedule == "CircleStep")
+        .map(|(_, s)| s)
+        .collect();
+    assert_eq!(
+        step,
+        [
+            "moving_circles::integrate::integrate_positions",
+            "moving_circles::boundary::bounce_off_walls",
+            "moving_circles::collide::collide_circles",
+        ]
+    );
+    assert!(system_names(&mut app).contains(&"moving_circles::spawn::spawn_circles".to_owned()));
+}
+
+#[test]
+fn without_collisions_there_is_no_collision_system() {
+    let config = CirclesConfig {
+        effects: Effects {
+            collisions: false,
+            ..default()
+        },
+        ..default()
+    };
+    let mut app = create_app(config);
+    let names = system_names(&mut app);
+    assert!(!names.iter().any(|n| n.contains("collide")), "{names:#?}");
+    assert!(
+        names.iter().any(|n| n.contains("integrate_positions")),
+        "{names:#?}"
+    );
+    // And the circles really pass through each other.
+    let mut app = create_app(empty(CirclesConfig {
+        effects: Effects {
+            collisions: false,
+            ..default()
+        },
+        ..default()
+    }));
+    spawn_circle(
+        &mut app,
+        Vec2::new(-1.0, 0.0),
+        Vec2::new(1.0, 0.0),
+        0.5,
+        1.0,
+    );
+    spawn_circle(
+        &mut app,
+        Vec2::new(1.0, 0.0),
+        Vec2::new(-1.0, 0.0),
+        0.5,
+        1.0,
+    );
+    step(&mut app, 120);
+    let xs: Vec<f32> = circles(&mut app).iter().map(|c| c.0.x).collect();
+    assert!(
+        xs[0] > 0.0 && xs[1] < 0.0,
+        "without collisions the circles cross: {xs:?}"
+    );
+}
+
+#[test]
+fn a_part_can_be_disabled_like_any_bevy_plugin_group() {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        CirclesPlugins::default().build().disable::<WallsPlugin>(),
+    ));
+    app.finish();
+    app.cleanup();
+    app.update();
+    let names = system_names(&mut app);
+    assert!(
+        !names.iter().any(|n| n.contains("bounce_off_walls")),
+        "{names:#?}"
+    );
+    assert!(
+        names.iter().any(|n| n.contains("collide_circles")),
+        "{names:#?}"
+    );
+}
