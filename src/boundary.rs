@@ -1,5 +1,6 @@
-//! Walls: the seed's reflection rules in vector form ([`reflect_off_walls`], a plain function)
-//! and [`WallsPlugin`], which applies them in [`CircleSystems::Boundary`].
+//! The arena's edges: walls with the seed's reflection rules in vector form
+//! ([`reflect_off_walls`], a plain function; [`WallsPlugin`]) or periodic wrap-around
+//! ([`wrap_into`]; [`PeriodicPlugin`]), in [`CircleSystems::Boundary`](crate::CircleSystems).
 //!
 //! Per axis: a circle whose edge is past a wall and that moves outward is mirrored back inside
 //! and its normal velocity flipped; one that is past a wall but already moving inward (pushed
@@ -7,10 +8,10 @@
 
 use bevy::prelude::*;
 
-use crate::components::{Position, Radius, Velocity};
-use crate::config::Arena;
+use crate::components::{Mass, Position, Radius, Velocity};
+use crate::config::{Arena, Effects};
 use crate::diagnostics::CollisionCounters;
-use crate::schedule::{CircleStep, CircleSystems};
+use crate::effects::{Effect, schedule_effect};
 
 /// Keeps every circle inside the [`Arena`] by reflecting it off the walls.
 #[derive(Clone, Copy, Debug, Default)]
@@ -18,11 +19,45 @@ pub struct WallsPlugin;
 
 impl Plugin for WallsPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(CircleStep, bounce_off_walls.in_set(CircleSystems::Boundary));
+        schedule_effect(app, Effect::Walls);
     }
 }
 
-/// Reflects one circle off the walls of `arena`; returns how many wall hits that took.
+/// Makes the [`Arena`] periodic: circles leaving one side enter at the opposite one.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PeriodicPlugin;
+
+impl Plugin for PeriodicPlugin {
+    fn build(&self, app: &mut App) {
+        schedule_effect(app, Effect::Periodic);
+    }
+}
+
+/// `p` moved into `[min, max)` on both axes by whole periods.
+pub fn wrap_into(p: Vec2, arena: &Arena) -> Vec2 {
+    let size = arena.size();
+    let wrapped = arena.min + (p - arena.min).rem_euclid(size);
+    // rem_euclid can round up to exactly `size`; that point is `min` again.
+    Vec2::select(wrapped.cmpge(arena.max), arena.min, wrapped)
+}
+
+/// The shortest displacement from `a` to `b` on a periodic arena of this size (minimum image).
+pub fn minimum_image(d: Vec2, size: Vec2) -> Vec2 {
+    d - size * (d / size).round()
+}
+
+/// Wraps every circle's centre back into the arena.
+pub fn wrap_around(arena: Res<Arena>, mut circles: Query<&mut Position>) {
+    let arena = *arena;
+    circles.par_iter_mut().for_each(|mut p| {
+        if !arena.contains(p.0) || p.0.cmpeq(arena.max).any() {
+            p.0 = wrap_into(p.0, &arena);
+        }
+    });
+}
+
+/// Reflects one circle off the walls of `arena`, scaling the normal velocity by `restitution`
+/// at each hit; returns how many wall hits that took.
 ///
 /// A circle that overshot by several arena widths in one step (a huge speed or `dt`) is folded
 /// back exactly as if it had bounced each time, so it always ends inside. A circle wider than
@@ -32,12 +67,17 @@ pub fn reflect_off_walls(
     velocity: &mut Vec2,
     radius: f32,
     arena: &Arena,
+    restitution: f32,
 ) -> u32 {
     let mut hits = 0;
     for axis in 0..2 {
         let lo = arena.min[axis] + radius;
         let hi = arena.max[axis] - radius;
-        hits += reflect_axis(&mut position[axis], &mut velocity[axis], lo, hi);
+        let n = reflect_axis(&mut position[axis], &mut velocity[axis], lo, hi);
+        if n > 0 && restitution != 1.0 {
+            velocity[axis] *= restitution.powi(n as i32);
+        }
+        hits += n;
     }
     hits
 }
@@ -81,23 +121,30 @@ fn reflect_axis(p: &mut f32, v: &mut f32, lo: f32, hi: f32) -> u32 {
     crossings.max(1)
 }
 
-/// Applies [`reflect_off_walls`] to every circle and counts the hits.
+/// Applies [`reflect_off_walls`] to every circle, counts the hits and adds the momentum the
+/// walls took up (`Σ m |Δv|`, for the wall pressure).
 pub fn bounce_off_walls(
     arena: Res<Arena>,
+    effects: Res<Effects>,
     mut counters: ResMut<CollisionCounters>,
-    mut circles: Query<(&mut Position, &mut Velocity, &Radius)>,
+    mut circles: Query<(&mut Position, &mut Velocity, &Radius, &Mass)>,
 ) {
     let mut hits = 0u64;
-    for (mut position, mut velocity, radius) in &mut circles {
+    let mut impulse = 0.0f64;
+    for (mut position, mut velocity, radius, mass) in &mut circles {
         let (mut p, mut v) = (position.0, velocity.0);
-        let n = reflect_off_walls(&mut p, &mut v, radius.0, &arena);
+        let n = reflect_off_walls(&mut p, &mut v, radius.0, &arena, effects.wall_restitution);
         if n > 0 || p != position.0 {
+            if n > 0 && mass.0.is_finite() {
+                impulse += f64::from(mass.0) * f64::from((v - velocity.0).length());
+            }
             position.0 = p;
             velocity.0 = v;
             hits += u64::from(n);
         }
     }
     counters.wall_collisions += hits;
+    counters.wall_impulse += impulse;
 }
 
 #[cfg(test)]
@@ -114,7 +161,7 @@ mod tests {
     #[test]
     fn overshoot_is_mirrored_and_velocity_flipped() {
         let (mut p, mut v) = (Vec2::new(1.05, 0.5), Vec2::new(1.0, 0.2));
-        let hits = reflect_off_walls(&mut p, &mut v, 0.1, &unit());
+        let hits = reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0);
         assert_eq!(hits, 1);
         assert!((p.x - 0.75).abs() < 1e-6, "{p}");
         assert_eq!(v, Vec2::new(-1.0, 0.2));
@@ -123,7 +170,7 @@ mod tests {
     #[test]
     fn a_circle_already_moving_inward_is_put_back_not_flipped() {
         let (mut p, mut v) = (Vec2::new(0.05, 0.5), Vec2::new(0.3, 0.0));
-        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 0);
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 0);
         assert_eq!(p, Vec2::new(0.1, 0.5));
         assert_eq!(v, Vec2::new(0.3, 0.0));
     }
@@ -133,21 +180,47 @@ mod tests {
         // lo = 0.1, hi = 0.9, span 0.8: 3.3 past lo is 4 wall hits (even: same direction)
         // and 0.1 into the fifth span.
         let (mut p, mut v) = (Vec2::new(3.4, 0.5), Vec2::new(5.0, 0.0));
-        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 4);
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 4);
         assert!((p.x - 0.2).abs() < 1e-5, "{p}");
         assert_eq!(v.x, 5.0);
         // 0.9 + 0.5 past hi: one hit, mirrored to 0.4, moving back.
         let (mut p, mut v) = (Vec2::new(1.4, 0.5), Vec2::new(5.0, 0.0));
-        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 1);
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 1);
         assert!((p.x - 0.4).abs() < 1e-5, "{p}");
         assert_eq!(v.x, -5.0);
         // Past the low wall, moving out: one hit.
         let (mut p, mut v) = (Vec2::new(-0.1, 0.5), Vec2::new(-5.0, 0.0));
-        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit()), 1);
+        assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 1);
         assert!((p.x - 0.3).abs() < 1e-5, "{p}");
         assert_eq!(v.x, 5.0);
         let (mut p, mut v) = (Vec2::new(-1e7, 0.5), Vec2::new(-1e9, 0.0));
-        reflect_off_walls(&mut p, &mut v, 0.1, &unit());
+        reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0);
         assert!(unit().contains(p) && p.is_finite());
+    }
+
+    #[test]
+    fn wall_restitution_scales_the_normal_velocity_per_hit() {
+        let (mut p, mut v) = (Vec2::new(1.05, 0.5), Vec2::new(2.0, 1.0));
+        reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 0.5);
+        assert_eq!(v, Vec2::new(-1.0, 1.0));
+    }
+
+    #[test]
+    fn wrapping_lands_inside_and_minimum_image_is_shortest() {
+        let arena = unit();
+        for p in [
+            Vec2::new(1.2, -0.3),
+            Vec2::new(-1e-9, 1.0),
+            Vec2::new(7.5, 3.25),
+        ] {
+            let w = wrap_into(p, &arena);
+            assert!(
+                w.cmpge(Vec2::ZERO).all() && w.cmplt(Vec2::ONE).all(),
+                "{p} → {w}"
+            );
+        }
+        assert!(
+            (minimum_image(Vec2::new(0.9, -0.8), Vec2::ONE) - Vec2::new(-0.1, 0.2)).length() < 1e-6
+        );
     }
 }

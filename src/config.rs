@@ -58,6 +58,7 @@ impl Arena {
 
 /// How a spawned circle's mass is chosen.
 #[derive(Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum MassModel {
     /// Mass proportional to area: `density · π r²`.
     Area {
@@ -87,9 +88,12 @@ impl MassModel {
 /// Random placement of circles: how many, how big, how fast. Seeded and reproducible.
 #[derive(Resource, Reflect, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[reflect(Resource, Debug)]
+#[serde(default, deny_unknown_fields)]
 pub struct SpawnConfig {
-    /// How many circles to place.
+    /// How many circles to place (ignored when `area_fraction` is set).
     pub count: usize,
+    /// Fill this fraction of the arena's area instead of placing `count` circles.
+    pub area_fraction: Option<f32>,
     /// Smallest and largest radius; radii are drawn uniformly in between.
     pub radius: (f32, f32),
     /// Smallest and largest speed; directions are uniform.
@@ -107,11 +111,30 @@ impl Default for SpawnConfig {
     fn default() -> Self {
         Self {
             count: 32,
+            area_fraction: None,
             radius: (0.2, 0.6),
             speed: (1.0, 4.0),
             seed: 1,
             mass: MassModel::default(),
             attempts_per_circle: 200,
+        }
+    }
+}
+
+impl SpawnConfig {
+    /// How many circles to place in `arena`: `count`, or as many as make up `area_fraction` of
+    /// its area on average (`E[r²] = (a² + ab + b²) / 3` for radii uniform in `[a, b]`).
+    pub fn target_count(&self, arena: &Arena) -> usize {
+        let Some(fraction) = self.area_fraction else {
+            return self.count;
+        };
+        let (a, b) = self.radius;
+        let mean_square = (a * a + a * b + b * b) / 3.0;
+        let n = fraction * arena.area() / (std::f32::consts::PI * mean_square);
+        if n.is_finite() && n > 0.0 {
+            n.round() as usize
+        } else {
+            0
         }
     }
 }
@@ -182,27 +205,68 @@ impl<'de> Deserialize<'de> for Solver {
     }
 }
 
-/// The effects a scene calls for. Only these get systems in the schedule.
+/// What happens at the edges of the arena.
+#[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Boundary {
+    /// Solid walls: circles bounce off them.
+    #[default]
+    Walls,
+    /// Periodic: a circle leaving one side enters at the opposite one, and circles interact
+    /// across the seam (minimum image).
+    Periodic,
+}
+
+impl FromStr for Boundary {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "walls" => Ok(Self::Walls),
+            "periodic" => Ok(Self::Periodic),
+            other => Err(format!(
+                "unknown boundary `{other}`: expected `walls` or `periodic`"
+            )),
+        }
+    }
+}
+
+/// The effects a scene calls for. Only these get systems in the schedule: no gravity, no
+/// gravity system; no collisions, no broad phase.
 #[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[reflect(Resource, Debug)]
+#[serde(default, deny_unknown_fields)]
 pub struct Effects {
+    /// Walls or periodic edges.
+    pub boundary: Boundary,
     /// Circle-circle collisions (broad phase, separation and impulse).
     pub collisions: bool,
+    /// Constant acceleration, e.g. `(0, -9.81)`; `None` schedules no gravity system.
+    pub gravity: Option<Vec2>,
+    /// Linear drag rate in 1/s (`v' = -drag · v`); `None` schedules no drag system.
+    pub drag: Option<f32>,
     /// Coefficient of restitution between circles: 1 is perfectly elastic.
     pub restitution: f32,
+    /// Coefficient of restitution against the walls.
+    pub wall_restitution: f32,
 }
 
 impl Default for Effects {
     fn default() -> Self {
         Self {
+            boundary: Boundary::Walls,
             collisions: true,
+            gravity: None,
+            drag: None,
             restitution: 1.0,
+            wall_restitution: 1.0,
         }
     }
 }
 
-/// Everything [`CirclesPlugins`](crate::CirclesPlugins) needs, in one value.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// Everything [`CirclesPlugins`](crate::CirclesPlugins) needs, in one value. Scene files
+/// ([`crate::scene`]) are read into this.
+#[derive(Clone, Debug, PartialEq)]
 pub struct CirclesConfig {
     /// The walls.
     pub arena: Arena,
@@ -214,6 +278,8 @@ pub struct CirclesConfig {
     pub effects: Effects,
     /// The fixed step in seconds.
     pub dt: f64,
+    /// Circles placed exactly as given, before the random ones.
+    pub circles: Vec<crate::spawn::CircleInit>,
 }
 
 impl Default for CirclesConfig {
@@ -225,6 +291,7 @@ impl Default for CirclesConfig {
             solver: Solver::default(),
             effects: Effects::default(),
             dt: 1.0 / 60.0,
+            circles: Vec::new(),
         }
     }
 }

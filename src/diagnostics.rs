@@ -5,7 +5,8 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Mass, Radius, Velocity};
+use crate::components::{Mass, Position, Radius, Velocity};
+use crate::config::{Arena, Effects};
 use crate::schedule::CircleSystems;
 use crate::spawn::SpawnReport;
 
@@ -14,12 +15,78 @@ use crate::spawn::SpawnReport;
 pub struct CollisionCounters {
     /// Fixed steps advanced.
     pub steps: u64,
+    /// Simulated seconds advanced.
+    pub sim_seconds: f64,
     /// Circle-circle impulses applied.
     pub pair_collisions: u64,
     /// Wall reflections.
     pub wall_collisions: u64,
-    /// Deepest overlap the collision pass found, as a fraction of the smaller radius.
+    /// Overlapping pairs the collision passes found (each pass counts its own).
+    pub contacts: u64,
+    /// Deepest overlap the collision passes found, as a fraction of the smaller radius.
     pub max_penetration: f32,
+    /// Sum of the overlaps found, as fractions of the smaller radius.
+    pub penetration_sum: f64,
+    /// Momentum the walls took up, `Σ m |Δv|` over wall hits.
+    pub wall_impulse: f64,
+    /// Collisional virial `Σ (r_a + r_b) · j` over circle-circle impulses.
+    pub virial: f64,
+}
+
+impl CollisionCounters {
+    /// Adds one collision pass.
+    pub fn record_pass(&mut self, pass: &crate::collide::PassStats) {
+        self.pair_collisions += pass.collisions;
+        self.contacts += pass.contacts;
+        self.max_penetration = self.max_penetration.max(pass.max_penetration);
+        self.penetration_sum += pass.penetration_sum;
+        self.virial += pass.virial;
+    }
+
+    /// Mean overlap of the contacts found, as a fraction of the smaller radius (0 if none).
+    pub fn mean_penetration(&self) -> f64 {
+        if self.contacts == 0 {
+            0.0
+        } else {
+            self.penetration_sum / self.contacts as f64
+        }
+    }
+}
+
+/// Pressure as the compressibility factor `z = P·A / (N·kT)`, with `kT` the mean kinetic energy
+/// per circle (2D), measured two ways over the time since the last reset.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Pressure {
+    /// From the collisional virial: `z = 1 + Σ σ·j / (2·T·N·kT)`. Works for walls and periodic
+    /// boxes; 1 is an ideal gas.
+    pub z_virial: Option<f64>,
+    /// From the momentum the walls took up: `P = Σ m|Δv| / (T · perimeter)` (walls only).
+    pub z_wall: Option<f64>,
+}
+
+impl Pressure {
+    /// Pressure of `n` circles with total kinetic energy `kinetic_energy` in `arena`, from the
+    /// counters. `None` where it is undefined (no time, no circles, no motion, or no walls).
+    pub fn measure(
+        counters: &CollisionCounters,
+        n: usize,
+        kinetic_energy: f64,
+        arena: &crate::config::Arena,
+        walls: bool,
+    ) -> Self {
+        let t = counters.sim_seconds;
+        let n_kt = kinetic_energy; // N·kT = total kinetic energy in 2D
+        if !(t > 0.0 && n > 0 && n_kt > 0.0) {
+            return Self::default();
+        }
+        let size = arena.size().as_dvec2();
+        let area = size.x * size.y;
+        let perimeter = 2.0 * (size.x + size.y);
+        Self {
+            z_virial: Some(1.0 + counters.virial / (2.0 * t * n_kt)),
+            z_wall: walls.then(|| counters.wall_impulse / (t * perimeter) * area / n_kt),
+        }
+    }
 }
 
 /// Conserved quantities of the whole system, measured after every fixed step.
@@ -29,8 +96,12 @@ pub struct CircleDiagnostics {
     pub count: usize,
     /// Total kinetic energy `Σ ½ m |v|²` (f64 sum, so the measurement adds no drift).
     pub kinetic_energy: f64,
-    /// Kinetic energy right after the last (re)spawn.
-    pub initial_kinetic_energy: f64,
+    /// Total mechanical energy: kinetic plus, under gravity, potential (see [`Totals`]).
+    pub energy: f64,
+    /// Mechanical energy right after the last (re)spawn.
+    pub initial_energy: f64,
+    /// Centres outside the arena.
+    pub escaped: usize,
     /// Total momentum `Σ m v`.
     pub momentum: DVec2,
     /// Whether any circle has a non-finite position or velocity.
@@ -40,43 +111,79 @@ pub struct CircleDiagnostics {
 }
 
 impl CircleDiagnostics {
-    /// Relative kinetic-energy change since the last reset: `(E - E0) / E0`, or the absolute
-    /// change when `E0` is zero (so it is always finite).
+    /// Relative change of the mechanical energy since the last reset: `(E - E0) / |E0|`, or the
+    /// absolute change when `E0` is zero (so it is always finite).
     pub fn energy_drift(&self) -> f64 {
-        relative_change(self.initial_kinetic_energy, self.kinetic_energy)
+        relative_change(self.initial_energy, self.energy)
     }
 }
 
-/// `(now - before) / before`, falling back to `now - before` when `before` is zero.
+/// `(now - before) / |before|`, falling back to `now - before` when `before` is zero.
 pub fn relative_change(before: f64, now: f64) -> f64 {
     if before != 0.0 {
-        (now - before) / before
+        (now - before) / before.abs()
     } else {
         now - before
     }
 }
 
-/// Kinetic energy and momentum of a set of circles, summed in f64.
-pub fn energy_and_momentum<'a>(
-    circles: impl Iterator<Item = (&'a Velocity, &'a Mass)>,
-) -> (f64, DVec2, usize) {
-    let mut energy = 0.0;
-    let mut momentum = DVec2::ZERO;
-    let mut non_finite = 0;
-    for (v, m) in circles {
-        if !v.0.is_finite() {
-            non_finite += 1;
-            continue;
+/// Totals over a set of circles, summed in f64.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Totals {
+    /// Number of circles.
+    pub count: usize,
+    /// `Σ ½ m |v|²`.
+    pub kinetic_energy: f64,
+    /// `Σ m g·(floor - x)`, measured from the arena's lowest corner along `g` (0 without
+    /// gravity).
+    pub potential_energy: f64,
+    /// `Σ m v`.
+    pub momentum: DVec2,
+    /// Circles with a non-finite position or velocity.
+    pub non_finite: usize,
+    /// Centres outside the arena.
+    pub escaped: usize,
+}
+
+impl Totals {
+    /// Measures `(position, velocity, mass)` triples. Immovable (infinite-mass) circles carry no
+    /// energy or momentum.
+    pub fn measure(
+        circles: impl Iterator<Item = (Vec2, Vec2, f32)>,
+        arena: &Arena,
+        gravity: Option<Vec2>,
+    ) -> Self {
+        let g = gravity.unwrap_or(Vec2::ZERO).as_dvec2();
+        // Potential energy is measured from the arena's lowest corner along g, so it is never
+        // negative and a relative drift stays meaningful.
+        let floor = DVec2::select(
+            g.cmpgt(DVec2::ZERO),
+            arena.max.as_dvec2(),
+            arena.min.as_dvec2(),
+        );
+        let mut totals = Self::default();
+        for (p, v, m) in circles {
+            totals.count += 1;
+            if !(p.is_finite() && v.is_finite()) {
+                totals.non_finite += 1;
+                continue;
+            }
+            totals.escaped += usize::from(!arena.contains(p));
+            if !m.is_finite() {
+                continue;
+            }
+            let (p, v, m) = (p.as_dvec2(), v.as_dvec2(), f64::from(m));
+            totals.kinetic_energy += 0.5 * m * v.length_squared();
+            totals.potential_energy += m * g.dot(floor - p);
+            totals.momentum += m * v;
         }
-        if !m.0.is_finite() {
-            continue; // immovable circles carry no kinetic energy
-        }
-        let v = v.0.as_dvec2();
-        let m = f64::from(m.0);
-        energy += 0.5 * m * v.length_squared();
-        momentum += m * v;
+        totals
     }
-    (energy, momentum, non_finite)
+
+    /// Kinetic plus potential energy.
+    pub fn energy(&self) -> f64 {
+        self.kinetic_energy + self.potential_energy
+    }
 }
 
 /// Measures energy and momentum after every fixed step.
@@ -100,18 +207,26 @@ impl Plugin for DiagnosticsPlugin {
 /// Updates [`CircleDiagnostics`]; after a (re)spawn, takes the new baseline and zeroes counters.
 pub fn measure(
     report: Res<SpawnReport>,
+    arena: Res<Arena>,
+    effects: Res<Effects>,
     mut diagnostics: ResMut<CircleDiagnostics>,
     mut counters: ResMut<CollisionCounters>,
-    circles: Query<(&Velocity, &Mass), With<Radius>>,
+    circles: Query<(&Position, &Velocity, &Mass), With<Radius>>,
 ) {
-    let (energy, momentum, non_finite) = energy_and_momentum(circles.iter());
-    diagnostics.count = circles.iter().len();
-    diagnostics.kinetic_energy = energy;
-    diagnostics.momentum = momentum;
-    diagnostics.non_finite = non_finite;
+    let totals = Totals::measure(
+        circles.iter().map(|(p, v, m)| (p.0, v.0, m.0)),
+        &arena,
+        effects.gravity,
+    );
+    diagnostics.count = totals.count;
+    diagnostics.kinetic_energy = totals.kinetic_energy;
+    diagnostics.energy = totals.energy();
+    diagnostics.momentum = totals.momentum;
+    diagnostics.non_finite = totals.non_finite;
+    diagnostics.escaped = totals.escaped;
     if diagnostics.generation != report.generation {
         diagnostics.generation = report.generation;
-        diagnostics.initial_kinetic_energy = energy;
+        diagnostics.initial_energy = totals.energy();
         *counters = CollisionCounters::default();
     }
 }

@@ -36,18 +36,22 @@ pub mod collide;
 pub mod components;
 pub mod config;
 pub mod diagnostics;
+pub mod effects;
 pub mod integrate;
 #[cfg(feature = "render")]
 pub mod render;
+pub mod run;
+pub mod scene;
 pub mod schedule;
 pub mod spawn;
 
 use bevy::app::{PluginGroup, PluginGroupBuilder};
 
-use boundary::WallsPlugin;
+use boundary::{PeriodicPlugin, WallsPlugin};
 use collide::CollidePlugin;
 use config::CirclesConfig;
 use diagnostics::DiagnosticsPlugin;
+use effects::{DragPlugin, Effect, GravityPlugin};
 use integrate::IntegratePlugin;
 use schedule::StepPlugin;
 use spawn::SpawnPlugin;
@@ -55,12 +59,16 @@ use spawn::SpawnPlugin;
 /// The common imports: components, config, plugins and system sets.
 pub mod prelude {
     pub use crate::CirclesPlugins;
-    pub use crate::boundary::WallsPlugin;
-    pub use crate::collide::{CollidePlugin, CollisionSettings};
+    pub use crate::boundary::{PeriodicPlugin, WallsPlugin};
+    pub use crate::collide::CollidePlugin;
     pub use crate::components::{Mass, Position, Radius, Tint, Velocity};
-    pub use crate::config::{Arena, CirclesConfig, Effects, MassModel, Solver, SpawnConfig};
+    pub use crate::config::{
+        Arena, Boundary, CirclesConfig, Effects, MassModel, Solver, SpawnConfig,
+    };
     pub use crate::diagnostics::{CircleDiagnostics, CollisionCounters, DiagnosticsPlugin};
+    pub use crate::effects::{DragPlugin, Effect, GravityPlugin};
     pub use crate::integrate::IntegratePlugin;
+    pub use crate::scene::Scene;
     pub use crate::schedule::{CircleStep, CircleSystems, StepPlugin};
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
 }
@@ -69,7 +77,8 @@ pub use components::{Mass, Position, Radius, Tint, Velocity};
 pub use schedule::CircleSystems;
 
 /// The simulation as a plugin group: [`StepPlugin`], [`SpawnPlugin`], [`IntegratePlugin`],
-/// [`WallsPlugin`], [`CollidePlugin`] (only when `effects.collisions`) and [`DiagnosticsPlugin`].
+/// [`DiagnosticsPlugin`], and one plugin per effect the configuration calls for:
+/// [`GravityPlugin`], [`DragPlugin`], [`WallsPlugin`] or [`PeriodicPlugin`], [`CollidePlugin`].
 ///
 /// Effects a configuration does not call for are not added at all, so they cost nothing.
 /// Parts can be switched off or replaced the Bevy way:
@@ -103,19 +112,30 @@ impl PluginGroup for CirclesPlugins {
             solver,
             effects,
             dt,
+            circles,
         } = self.config;
-        let group = PluginGroupBuilder::start::<Self>()
-            .add(StepPlugin { arena, solver, dt })
-            .add(SpawnPlugin { config: spawn })
-            .add(IntegratePlugin)
-            .add(WallsPlugin);
-        let group = if effects.collisions {
-            group.add(CollidePlugin {
-                restitution: effects.restitution,
+        let mut group = PluginGroupBuilder::start::<Self>()
+            .add(StepPlugin {
+                arena,
+                solver,
+                effects,
+                dt,
             })
-        } else {
-            group
-        };
-        group.add(DiagnosticsPlugin)
+            .add(SpawnPlugin {
+                config: spawn,
+                circles,
+            })
+            .add(IntegratePlugin)
+            .add(DiagnosticsPlugin);
+        for effect in Effect::called_for(&effects) {
+            group = match effect {
+                Effect::Gravity => group.add(GravityPlugin),
+                Effect::Drag => group.add(DragPlugin),
+                Effect::Walls => group.add(WallsPlugin),
+                Effect::Periodic => group.add(PeriodicPlugin),
+                Effect::Collisions => group.add(CollidePlugin),
+            };
+        }
+        group
     }
 }

@@ -1,23 +1,54 @@
-//! The `moving_circles` binary: opens the app (feature `render`) with the seed's scene, or a
-//! configured one.
+//! The `moving_circles` binary: opens the app (feature `render`) on a scene, or runs headless
+//! batch work (`run`, `systems`). Argument parsing and error reporting live here; the work itself
+//! is in the library (`moving_circles::run`, `moving_circles::scene`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::Parser;
+use anyhow::{Context, bail};
+use bevy::prelude::default;
+use clap::{Args, Parser, Subcommand};
 use moving_circles::prelude::*;
+use moving_circles::run::{Report, headless_app, run_steps, snapshot};
+use moving_circles::scene::{DT_RANGE, particles};
+use moving_circles::schedule::scheduled_systems;
 
 /// Moving, colliding circles. Without a subcommand, opens the app.
 #[derive(Parser, Debug)]
 #[command(version, about)]
 struct Cli {
-    /// Number of circles to spawn.
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    app: AppArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run a scene or particle file headless and report (no window).
+    Run(RunArgs),
+    /// Print the systems a scene schedules, one per line.
+    Systems {
+        /// The scene (RON).
+        #[arg(long, value_name = "PATH")]
+        scene: PathBuf,
+    },
+}
+
+/// Options of the windowed app.
+#[derive(Args, Debug)]
+struct AppArgs {
+    /// Scene file (RON) to open; the app reloads it when it changes. Default: the built-in
+    /// `classic` scene.
+    #[arg(long, value_name = "PATH")]
+    scene: Option<PathBuf>,
+    /// Number of random circles (overrides the scene).
     #[arg(long)]
     count: Option<usize>,
-    /// Seed of the random placement.
+    /// Seed of the random placement (overrides the scene).
     #[arg(long)]
     seed: Option<u64>,
-    /// Solver: `discrete` or `substeps=N`.
+    /// Solver: `discrete` or `substeps=N` (overrides the scene).
     #[arg(long)]
     solver: Option<Solver>,
     /// Render `--frames` frames, save the window to this PNG and exit.
@@ -28,25 +59,227 @@ struct Cli {
     frames: u32,
 }
 
+#[derive(Args, Debug)]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["scene", "particles"])))]
+#[command(group(clap::ArgGroup::new("length").required(true).args(["seconds", "steps"])))]
+struct RunArgs {
+    /// Scene file (RON).
+    #[arg(long, value_name = "PATH")]
+    scene: Option<PathBuf>,
+    /// Particle file: `N`, then `rx ry vx vy radius mass r g b` per line, in the unit square.
+    #[arg(long, value_name = "PATH")]
+    particles: Option<PathBuf>,
+    /// Solver: `discrete` or `substeps=N` (default: the scene's, or `discrete`).
+    #[arg(long)]
+    solver: Option<Solver>,
+    /// Boundary of a particle file's unit square: `walls` or `periodic`.
+    #[arg(long, value_parser = parse_boundary)]
+    boundary: Option<Boundary>,
+    /// Fixed step in seconds, e.g. `0.01` or `1/60` (default: the scene's, or 1/60).
+    #[arg(long, value_parser = parse_dt)]
+    dt: Option<f64>,
+    /// Simulated seconds to run (rounded up to whole steps).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Fixed steps to run.
+    #[arg(long)]
+    steps: Option<u64>,
+    /// Seed of the random placement (overrides the scene).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Write the report (JSON) here.
+    #[arg(long, value_name = "PATH.json")]
+    report: Option<PathBuf>,
+    /// Write the final state here, in the particle format.
+    #[arg(long, value_name = "PATH.txt")]
+    dump: Option<PathBuf>,
+}
+
+fn parse_boundary(s: &str) -> Result<Boundary, String> {
+    s.parse()
+}
+
+fn parse_dt(s: &str) -> Result<f64, String> {
+    let value = match s.split_once('/') {
+        Some((a, b)) => {
+            let (a, b): (f64, f64) = (
+                a.trim()
+                    .parse()
+                    .map_err(|_| format!("`{s}` is not a number or fraction"))?,
+                b.trim()
+                    .parse()
+                    .map_err(|_| format!("`{s}` is not a number or fraction"))?,
+            );
+            a / b
+        }
+        None => s.parse().map_err(|_| format!("`{s}` is not a number"))?,
+    };
+    let (lo, hi) = DT_RANGE;
+    if value.is_finite() && (lo..=hi).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("must be between {lo} and {hi} seconds, got {s}"))
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let mut config = CirclesConfig::default();
-    if let Some(count) = cli.count {
-        config.spawn.count = count;
+    let result = match cli.command {
+        Some(Command::Run(args)) => run(args),
+        Some(Command::Systems { scene }) => systems(&scene),
+        None => return open_app(cli.app),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("moving_circles: {e:#}");
+            ExitCode::FAILURE
+        }
     }
-    if let Some(seed) = cli.seed {
-        config.spawn.seed = seed;
+}
+
+fn run(args: RunArgs) -> anyhow::Result<()> {
+    if args.scene.is_some() && args.boundary.is_some() {
+        bail!("--boundary applies to --particles files; a scene sets its own `arena.boundary`");
     }
-    if let Some(solver) = cli.solver {
+    let (mut config, source) = match (&args.scene, &args.particles) {
+        (Some(scene), _) => (Scene::load(scene)?, scene.display().to_string()),
+        (None, Some(file)) => {
+            let boundary = args.boundary.unwrap_or_default();
+            let circles = particles::read(file, boundary)?;
+            (
+                particle_config(circles, boundary),
+                file.display().to_string(),
+            )
+        }
+        (None, None) => unreachable!("clap requires --scene or --particles"),
+    };
+    if let Some(solver) = args.solver {
         config.solver = solver;
     }
-    open_app(config, cli.screenshot.map(|path| (path, cli.frames)))
+    if let Some(dt) = args.dt {
+        config.dt = dt;
+    }
+    if let Some(seed) = args.seed {
+        config.spawn.seed = seed;
+    }
+    let steps = match (args.steps, args.seconds) {
+        (Some(0), _) => bail!("--steps must be at least 1"),
+        (Some(steps), _) => steps,
+        (None, Some(t)) if t.is_finite() && t > 0.0 && t / config.dt <= 1e12 => {
+            (t / config.dt).ceil() as u64
+        }
+        (None, Some(t)) => {
+            bail!("--seconds must be positive, finite and at most 1e12 steps long, got {t}")
+        }
+        (None, None) => unreachable!("clap requires --seconds or --steps"),
+    };
+
+    let mut app = headless_app(config);
+    let spawn = *app.world().resource::<SpawnReport>();
+    if spawn.placed < spawn.requested {
+        eprintln!(
+            "moving_circles: warning: placed {} of {} circles; the arena has no room for more",
+            spawn.placed, spawn.requested
+        );
+    }
+    let bar = indicatif::ProgressBar::new(steps).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  eta {eta}")
+            .expect("valid template"),
+    );
+    let report = run_steps(&mut app, &source, steps, |done| bar.set_position(done));
+    bar.finish_and_clear();
+
+    print_summary(&report);
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report).context("serialising the report")?;
+        particles::write_atomically(path, &(json + "\n"))
+            .with_context(|| format!("writing the report to {}", path.display()))?;
+    }
+    if let Some(path) = &args.dump {
+        let state = snapshot(app.world_mut());
+        particles::write_atomically(path, &particles::format(&state))
+            .with_context(|| format!("writing the final state to {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// A particle file's circles in the unit square, with the default effects.
+fn particle_config(
+    circles: Vec<moving_circles::spawn::CircleInit>,
+    boundary: Boundary,
+) -> CirclesConfig {
+    CirclesConfig {
+        arena: particles::unit_square(),
+        spawn: SpawnConfig {
+            count: 0,
+            ..default()
+        },
+        effects: Effects {
+            boundary,
+            ..default()
+        },
+        circles,
+        ..default()
+    }
+}
+
+fn print_summary(r: &Report) {
+    println!(
+        "{} circles, {}, {} steps of {:.6} s in {:.3} s ({:.4} ms/step)",
+        r.n, r.solver, r.steps, r.dt, r.wall_seconds, r.ms_per_step
+    );
+    println!(
+        "energy drift {:+.3e}, max penetration {:.3e}, collisions {} pair / {} wall, escaped {}, non-finite {}",
+        r.energy_drift,
+        r.max_penetration,
+        r.pair_collisions,
+        r.wall_collisions,
+        r.escaped,
+        r.non_finite
+    );
+}
+
+fn systems(scene: &Path) -> anyhow::Result<()> {
+    let config = Scene::load(scene)?;
+    let mut app = headless_app(config);
+    for (schedule, system) in scheduled_systems(&mut app) {
+        let name = system.rsplit("::").next().unwrap_or(&system);
+        println!("{schedule} {name}");
+    }
+    Ok(())
 }
 
 #[cfg(feature = "render")]
-fn open_app(config: CirclesConfig, screenshot: Option<(PathBuf, u32)>) -> ExitCode {
+fn app_config(args: &AppArgs) -> anyhow::Result<CirclesConfig> {
+    let mut config = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => moving_circles::scene::classic(),
+    };
+    if let Some(count) = args.count {
+        config.spawn.count = count;
+        config.spawn.area_fraction = None;
+    }
+    if let Some(seed) = args.seed {
+        config.spawn.seed = seed;
+    }
+    if let Some(solver) = args.solver {
+        config.solver = solver;
+    }
+    Ok(config)
+}
+
+#[cfg(feature = "render")]
+fn open_app(args: AppArgs) -> ExitCode {
     use moving_circles::render::{self, NO_WINDOW_HINT};
 
+    let config = match app_config(&args) {
+        Ok(config) => config,
+        Err(e) => {
+            eprintln!("moving_circles: {e:#}");
+            return ExitCode::FAILURE;
+        }
+    };
     if let Some(problem) = render::display_problem() {
         eprintln!("{problem}");
         return ExitCode::FAILURE;
@@ -66,8 +299,11 @@ fn open_app(config: CirclesConfig, screenshot: Option<(PathBuf, u32)>) -> ExitCo
             .unwrap_or_default();
         eprintln!("moving_circles: the app stopped: {message}{location}\n\n{NO_WINDOW_HINT}");
     }));
-    let exit = render::app(config, screenshot).run();
-    if exit.is_success() {
+    let options = render::AppOptions {
+        scene_file: args.scene.clone(),
+        screenshot: args.screenshot.map(|path| (path, args.frames)),
+    };
+    if render::app(config, options).run().is_success() {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
@@ -75,10 +311,10 @@ fn open_app(config: CirclesConfig, screenshot: Option<(PathBuf, u32)>) -> ExitCo
 }
 
 #[cfg(not(feature = "render"))]
-fn open_app(_: CirclesConfig, _: Option<(PathBuf, u32)>) -> ExitCode {
+fn open_app(_: AppArgs) -> ExitCode {
     eprintln!(
         "moving_circles was built without the `render` feature, so it has no window; \
-         rebuild with default features"
+         use `moving_circles run` or rebuild with default features"
     );
     ExitCode::FAILURE
 }

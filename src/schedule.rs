@@ -3,7 +3,7 @@
 //!
 //! Data flow per fixed step (in `FixedUpdate`):
 //! `CircleSystems::Step` runs [`CircleStep`] `substeps` times with `dt / substeps`
-//! (`Integrate` → `Boundary` → `Collide`), then `CircleSystems::Diagnostics` measures the result.
+//! (`Forces` → `Integrate` → `Boundary` → `Collide`), then `CircleSystems::Diagnostics` measures the result.
 //! Spawning happens outside the fixed clock (`Startup` and `PreUpdate`, set `CircleSystems::Spawn`)
 //! so a paused simulation can still be reset.
 
@@ -12,7 +12,7 @@ use std::time::Duration;
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
-use crate::config::{Arena, Solver};
+use crate::config::{Arena, Effects, Solver};
 use crate::diagnostics::CollisionCounters;
 
 /// The system sets of the simulation, in the order they run.
@@ -22,6 +22,8 @@ pub enum CircleSystems {
     Spawn,
     /// Advancing one fixed step: runs [`CircleStep`] (`FixedUpdate`).
     Step,
+    /// Forces that change velocity: gravity, drag (inside [`CircleStep`]).
+    Forces,
     /// Moving circles over the step's `dt` (inside [`CircleStep`]).
     Integrate,
     /// Keeping circles inside the arena (inside [`CircleStep`]).
@@ -40,7 +42,7 @@ pub struct CircleStep;
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
 pub struct StepDt(pub f32);
 
-/// The core plugin: inserts the arena and solver, sets the fixed clock, builds [`CircleStep`]
+/// The core plugin: inserts the arena, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
 /// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
 #[derive(Clone, Debug)]
 pub struct StepPlugin {
@@ -48,6 +50,8 @@ pub struct StepPlugin {
     pub arena: Arena,
     /// How a fixed step is advanced.
     pub solver: Solver,
+    /// The effects and their parameters (which ones get systems is up to the effect plugins).
+    pub effects: Effects,
     /// The fixed step in seconds.
     pub dt: f64,
 }
@@ -57,6 +61,7 @@ impl Default for StepPlugin {
         Self {
             arena: Arena::default(),
             solver: Solver::default(),
+            effects: Effects::default(),
             dt: 1.0 / 60.0,
         }
     }
@@ -67,7 +72,9 @@ impl Plugin for StepPlugin {
         app.register_type::<Arena>()
             .register_type::<Solver>()
             .insert_resource(self.arena)
+            .register_type::<Effects>()
             .insert_resource(self.solver)
+            .insert_resource(self.effects)
             .insert_resource(Time::<Fixed>::from_duration(Duration::from_secs_f64(
                 self.dt,
             )))
@@ -77,6 +84,7 @@ impl Plugin for StepPlugin {
             .configure_sets(
                 CircleStep,
                 (
+                    CircleSystems::Forces,
                     CircleSystems::Integrate,
                     CircleSystems::Boundary,
                     CircleSystems::Collide,
@@ -99,7 +107,9 @@ pub fn run_circle_step(world: &mut World) {
     for _ in 0..substeps {
         world.run_schedule(CircleStep);
     }
-    world.resource_mut::<CollisionCounters>().steps += 1;
+    let mut counters = world.resource_mut::<CollisionCounters>();
+    counters.steps += 1;
+    counters.sim_seconds += dt;
 }
 
 /// The schedules the simulation adds systems to, in the order a frame meets them.

@@ -56,11 +56,16 @@ pub enum SpawnError {
     BadArena(Vec2, Vec2),
 }
 
-/// Places up to `config.count` non-overlapping circles inside `arena`, largest first.
+/// Places up to [`SpawnConfig::target_count`] non-overlapping circles inside `arena`, largest
+/// first, around the `fixed` circles already there (which are not returned).
 ///
-/// Returns the circles that fit, which is fewer than requested when the arena is too full
-/// (compare the length with `config.count`). The same config always gives the same circles.
-pub fn place_circles(arena: &Arena, config: &SpawnConfig) -> Result<Vec<CircleInit>, SpawnError> {
+/// Returns the circles that fit, which is fewer than requested when the arena is too full.
+/// The same config always gives the same circles.
+pub fn place_circles(
+    arena: &Arena,
+    config: &SpawnConfig,
+    fixed: &[CircleInit],
+) -> Result<Vec<CircleInit>, SpawnError> {
     let (r_min, r_max) = config.radius;
     if !(r_min.is_finite() && r_max.is_finite() && r_min > 0.0 && r_min <= r_max) {
         return Err(SpawnError::BadRadius(r_min, r_max));
@@ -74,15 +79,22 @@ pub fn place_circles(arena: &Arena, config: &SpawnConfig) -> Result<Vec<CircleIn
         return Err(SpawnError::BadArena(arena.min, arena.max));
     }
 
+    let count = config.target_count(arena);
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     // Largest first: big circles are the hard ones to fit once the arena fills up.
-    let mut radii: Vec<f32> = (0..config.count)
+    let mut radii: Vec<f32> = (0..count)
         .map(|_| rng.random_range(r_min..=r_max))
         .collect();
     radii.sort_by(|a, b| b.total_cmp(a));
 
-    let mut grid = PlacementGrid::new(arena, r_max, config.count);
-    let mut placed: Vec<CircleInit> = Vec::with_capacity(config.count);
+    // Fixed circles can be larger than any random one; the grid's cells must span the largest.
+    let largest = fixed.iter().map(|c| c.radius).fold(r_max, f32::max);
+    let mut grid = PlacementGrid::new(arena, largest, count + fixed.len());
+    let mut placed: Vec<CircleInit> = Vec::with_capacity(count + fixed.len());
+    for circle in fixed {
+        grid.insert(circle.position, placed.len());
+        placed.push(*circle);
+    }
     for r in radii {
         let lo = arena.min + Vec2::splat(r);
         let hi = arena.max - Vec2::splat(r);
@@ -109,7 +121,7 @@ pub fn place_circles(arena: &Arena, config: &SpawnConfig) -> Result<Vec<CircleIn
             tint: hue_to_rgb(rng.random_range(0.0..1.0)),
         });
     }
-    Ok(placed)
+    Ok(placed.split_off(fixed.len()))
 }
 
 fn sample_between(rng: &mut impl Rng, lo: f32, hi: f32) -> f32 {
@@ -153,7 +165,8 @@ impl PlacementGrid {
     fn new(arena: &Arena, r_max: f32, count: usize) -> Self {
         let size = arena.size();
         // Never more cells than about one per circle: a tiny radius in a big arena must not
-        // allocate millions of empty cells.
+        // allocate millions of empty cells. Cells span the largest diameter, so a 3×3 block
+        // around a new circle holds every circle it could overlap.
         let cell = (2.0 * r_max).max((size.x * size.y / count.max(1) as f32).sqrt());
         let cols = ((size.x / cell).ceil() as usize).max(1);
         let rows = ((size.y / cell).ceil() as usize).max(1);
@@ -217,17 +230,25 @@ pub struct SpawnReport {
     pub generation: u64,
 }
 
-/// Spawns random circles from a [`SpawnConfig`] at startup and on every [`Respawn`].
+/// Circles a scene places exactly, before the random ones.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct FixedCircles(pub Vec<CircleInit>);
+
+/// Spawns the [`FixedCircles`] and random circles from a [`SpawnConfig`] at startup and on
+/// every [`Respawn`].
 #[derive(Clone, Debug, Default)]
 pub struct SpawnPlugin {
-    /// What to spawn.
+    /// Random circles to place.
     pub config: SpawnConfig,
+    /// Circles to place exactly as given.
+    pub circles: Vec<CircleInit>,
 }
 
 impl Plugin for SpawnPlugin {
     fn build(&self, app: &mut App) {
         app.register_type::<SpawnConfig>()
             .insert_resource(self.config.clone())
+            .insert_resource(FixedCircles(self.circles.clone()))
             .init_resource::<SpawnReport>()
             .add_message::<Respawn>()
             .add_systems(Startup, spawn_circles.in_set(CircleSystems::Spawn))
@@ -240,33 +261,40 @@ impl Plugin for SpawnPlugin {
     }
 }
 
-/// Places circles from the [`SpawnConfig`] and spawns them.
+/// Spawns the [`FixedCircles`], then random circles placed from the [`SpawnConfig`].
 pub fn spawn_circles(
     mut commands: Commands,
     arena: Res<Arena>,
     config: Res<SpawnConfig>,
+    fixed: Res<FixedCircles>,
     mut report: ResMut<SpawnReport>,
 ) {
-    let circles = match place_circles(&arena, &config) {
+    let requested = config.target_count(&arena);
+    let random = match place_circles(&arena, &config, &fixed.0) {
         Ok(circles) => circles,
         Err(e) => {
             error!("cannot spawn circles: {e}");
             Vec::new()
         }
     };
-    if circles.len() < config.count {
+    if random.len() < requested {
         warn!(
-            "placed {} of {} circles: the arena has no room for more without overlap",
-            circles.len(),
-            config.count
+            "placed {} of {requested} random circles: the arena has no room for more without overlap",
+            random.len()
         );
     }
     *report = SpawnReport {
-        requested: config.count,
-        placed: circles.len(),
+        requested: requested + fixed.0.len(),
+        placed: random.len() + fixed.0.len(),
         generation: report.generation + 1,
     };
-    commands.spawn_batch(circles.iter().map(CircleInit::bundle).collect::<Vec<_>>());
+    let bundles: Vec<_> = fixed
+        .0
+        .iter()
+        .chain(&random)
+        .map(CircleInit::bundle)
+        .collect();
+    commands.spawn_batch(bundles);
 }
 
 /// Despawns every circle and places a fresh set.
@@ -276,13 +304,14 @@ pub fn respawn_circles(
     circles: Query<Entity, With<Radius>>,
     arena: Res<Arena>,
     config: Res<SpawnConfig>,
+    fixed: Res<FixedCircles>,
     report: ResMut<SpawnReport>,
 ) {
     requests.clear();
     for entity in &circles {
         commands.entity(entity).despawn();
     }
-    spawn_circles(commands, arena, config, report);
+    spawn_circles(commands, arena, config, fixed, report);
 }
 
 #[cfg(test)]
@@ -297,7 +326,7 @@ mod tests {
             radius: (0.3, 0.3),
             ..default()
         };
-        let circles = place_circles(&arena, &config).unwrap();
+        let circles = place_circles(&arena, &config, &[]).unwrap();
         // A 2×2 box holds at most 9 circles of radius 0.3 (3 per row at spacing 0.6 + walls).
         assert!(
             !circles.is_empty() && circles.len() <= 9,
@@ -314,7 +343,7 @@ mod tests {
             radius: (0.6, 0.6),
             ..default()
         };
-        assert!(place_circles(&arena, &config).unwrap().is_empty());
+        assert!(place_circles(&arena, &config, &[]).unwrap().is_empty());
     }
 
     #[test]
@@ -324,13 +353,13 @@ mod tests {
             radius: (0.5, 0.1),
             ..default()
         };
-        let err = place_circles(&arena, &bad_radius).unwrap_err();
+        let err = place_circles(&arena, &bad_radius, &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.radius"), "{err}");
         let bad_speed = SpawnConfig {
             speed: (f32::NAN, 1.0),
             ..default()
         };
-        let err = place_circles(&arena, &bad_speed).unwrap_err();
+        let err = place_circles(&arena, &bad_speed, &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.speed"), "{err}");
     }
 

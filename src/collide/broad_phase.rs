@@ -10,10 +10,13 @@ use bevy::math::Vec2;
 /// Circles bucketed by cell: `order[start[c]..start[c + 1]]` are the circles in cell `c`.
 #[derive(Debug, Default, Clone)]
 pub struct CellList {
+    periodic: bool,
     origin: Vec2,
     inv_cell: f32,
     cols: usize,
     rows: usize,
+    /// Cell height relative to width is `1 / y_scale` (1 unless periodic tiling needs otherwise).
+    y_scale: f32,
     start: Vec<u32>,
     order: Vec<u32>,
     cell_of: Vec<u32>,
@@ -44,10 +47,40 @@ impl CellList {
                 .max(extent.max_element() / max_cells)
                 .max(cell);
         }
+        self.periodic = false;
         self.origin = if lo.x <= hi.x { lo } else { Vec2::ZERO };
         self.inv_cell = 1.0 / cell;
+        self.y_scale = 1.0;
         self.cols = ((extent.x * self.inv_cell).floor() as usize + 1).max(1);
         self.rows = ((extent.y * self.inv_cell).floor() as usize + 1).max(1);
+        self.fill(positions);
+    }
+
+    /// Buckets `positions` (already wrapped into the periodic box at `min` of this `size`) into
+    /// a grid that tiles the box exactly, with cells at least `min_cell` wide.
+    pub fn rebuild_periodic(&mut self, positions: &[Vec2], min: Vec2, size: Vec2, min_cell: f32) {
+        let max_per_axis = ((4 * positions.len()).max(1) as f32).sqrt().ceil();
+        let per_axis = |length: f32| {
+            let n = (length / min_cell.max(f32::MIN_POSITIVE)).floor();
+            (n.min(max_per_axis) as usize).max(1)
+        };
+        self.periodic = true;
+        self.origin = min;
+        self.cols = per_axis(size.x);
+        self.rows = per_axis(size.y);
+        // Cells may be non-square here; `inv_cell` is per x, and y is rescaled by the ratio.
+        self.inv_cell = self.cols as f32 / size.x;
+        self.y_scale = (self.rows as f32 / size.y) / self.inv_cell;
+        self.fill(positions);
+    }
+
+    /// Whether the periodic grid is too coarse for the wrapped half stencil to visit each
+    /// neighbour cell once (fewer than three cells on an axis).
+    pub fn wraps_onto_itself(&self) -> bool {
+        self.periodic && (self.cols < 3 || self.rows < 3)
+    }
+
+    fn fill(&mut self, positions: &[Vec2]) {
         let cells = self.cols * self.rows;
 
         let mut cell_of = std::mem::take(&mut self.cell_of);
@@ -81,7 +114,10 @@ impl CellList {
         if !p.is_finite() {
             return NO_CELL;
         }
-        let c = (p - self.origin) * self.inv_cell;
+        let mut c = (p - self.origin) * self.inv_cell;
+        if self.periodic {
+            c.y *= self.y_scale;
+        }
         let x = (c.x.max(0.0) as usize).min(self.cols - 1);
         let y = (c.y.max(0.0) as usize).min(self.rows - 1);
         (y * self.cols + x) as u32
@@ -92,7 +128,28 @@ impl CellList {
         &self.order[self.start[c] as usize..self.start[c + 1] as usize]
     }
 
-    /// Calls `visit(i, j)` once for every pair of circles in the same or adjacent cells.
+    fn half_stencil(&self, x: usize, y: usize) -> [Option<(usize, usize)>; 4] {
+        let (cols, rows) = (self.cols, self.rows);
+        if self.periodic {
+            let (right, left, up) = ((x + 1) % cols, (x + cols - 1) % cols, (y + 1) % rows);
+            return [
+                Some((right, y)),
+                Some((left, up)),
+                Some((x, up)),
+                Some((right, up)),
+            ];
+        }
+        [
+            (x + 1 < cols).then(|| (x + 1, y)),
+            (y + 1 < rows && x > 0).then(|| (x - 1, y + 1)),
+            (y + 1 < rows).then(|| (x, y + 1)),
+            (y + 1 < rows && x + 1 < cols).then(|| (x + 1, y + 1)),
+        ]
+    }
+
+    /// Calls `visit(i, j)` once for every pair of circles in the same or adjacent cells
+    /// (on a periodic grid that [`wraps_onto_itself`](Self::wraps_onto_itself), pairs can repeat
+    /// and a circle can meet itself: callers dedupe).
     pub fn for_each_candidate_pair(&self, mut visit: impl FnMut(u32, u32)) {
         for y in 0..self.rows {
             for x in 0..self.cols {
@@ -103,13 +160,7 @@ impl CellList {
                     }
                 }
                 // Right, and the three cells of the row above: each neighbour pair once.
-                let neighbours = [
-                    (x + 1 < self.cols).then(|| (x + 1, y)),
-                    (y + 1 < self.rows && x > 0).then(|| (x - 1, y + 1)),
-                    (y + 1 < self.rows).then(|| (x, y + 1)),
-                    (y + 1 < self.rows && x + 1 < self.cols).then(|| (x + 1, y + 1)),
-                ];
-                for (nx, ny) in neighbours.into_iter().flatten() {
+                for (nx, ny) in self.half_stencil(x, y).into_iter().flatten() {
                     let there = self.cell(nx, ny);
                     for &i in here {
                         for &j in there {
@@ -122,23 +173,66 @@ impl CellList {
     }
 }
 
-/// Appends to `pairs` every pair `(i, j)` of circles that overlap (centre distance below the
-/// sum of radii), found through `cells`. The order depends only on the input, not on timing.
+/// The space the circles live in, as far as distances go.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Space {
+    /// Plain Euclidean distances.
+    Open,
+    /// A periodic box at `min` of this `size`: distances use the minimum image.
+    Periodic {
+        /// Lower-left corner.
+        min: Vec2,
+        /// Width and height.
+        size: Vec2,
+    },
+}
+
+impl Space {
+    /// The displacement from `a` to `b` (the minimum image on a periodic box).
+    #[inline]
+    pub fn offset(self, a: Vec2, b: Vec2) -> Vec2 {
+        match self {
+            Space::Open => b - a,
+            Space::Periodic { size, .. } => crate::boundary::minimum_image(b - a, size),
+        }
+    }
+}
+
+/// Appends to `pairs` every pair `(i, j)`, `i < j`, of circles that overlap (centre distance
+/// below the sum of radii), found through `cells`. The order depends only on the input.
 pub fn overlapping_pairs(
     cells: &mut CellList,
+    space: Space,
     positions: &[Vec2],
     radii: &[f32],
     pairs: &mut Vec<(u32, u32)>,
 ) {
     let max_radius = radii.iter().copied().fold(0.0f32, f32::max);
-    cells.rebuild(positions, 2.0 * max_radius);
+    match space {
+        Space::Open => cells.rebuild(positions, 2.0 * max_radius),
+        Space::Periodic { min, size } => {
+            cells.rebuild_periodic(positions, min, size, 2.0 * max_radius)
+        }
+    }
+    let start = pairs.len();
     cells.for_each_candidate_pair(|i, j| {
         let (a, b) = (i as usize, j as usize);
         let reach = radii[a] + radii[b];
-        if positions[a].distance_squared(positions[b]) < reach * reach {
+        if i != j && space.offset(positions[a], positions[b]).length_squared() < reach * reach {
             pairs.push((i.min(j), i.max(j)));
         }
     });
+    if cells.wraps_onto_itself() {
+        pairs[start..].sort_unstable();
+        let mut seen = start;
+        for k in start..pairs.len() {
+            if k == start || pairs[k] != pairs[seen - 1] {
+                pairs[seen] = pairs[k];
+                seen += 1;
+            }
+        }
+        pairs.truncate(seen);
+    }
 }
 
 #[cfg(test)]
@@ -147,12 +241,12 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    fn brute_force(positions: &[Vec2], radii: &[f32]) -> Vec<(u32, u32)> {
+    fn brute_force(space: Space, positions: &[Vec2], radii: &[f32]) -> Vec<(u32, u32)> {
         let mut pairs = Vec::new();
         for i in 0..positions.len() {
             for j in i + 1..positions.len() {
                 let reach = radii[i] + radii[j];
-                if positions[i].distance_squared(positions[j]) < reach * reach {
+                if space.offset(positions[i], positions[j]).length_squared() < reach * reach {
                     pairs.push((i as u32, j as u32));
                 }
             }
@@ -169,13 +263,58 @@ mod tests {
                 .collect();
             let radii: Vec<f32> = (0..n).map(|_| rng.random_range(0.01..0.3)).collect();
             let mut pairs = Vec::new();
-            overlapping_pairs(&mut CellList::default(), &positions, &radii, &mut pairs);
-            pairs.sort_unstable();
-            assert_eq!(
-                pairs,
-                brute_force(&positions, &radii),
-                "n = {n}, spread = {spread}"
+            overlapping_pairs(
+                &mut CellList::default(),
+                Space::Open,
+                &positions,
+                &radii,
+                &mut pairs,
             );
+            pairs.sort_unstable();
+            let expected = brute_force(Space::Open, &positions, &radii);
+            assert_eq!(pairs, expected, "n = {n}, spread = {spread}");
+        }
+    }
+
+    #[test]
+    fn periodic_pairs_across_the_seam_are_found_once() {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        // Box sizes from one cell per axis (every neighbour is the cell itself) to many.
+        for (n, side, r_max) in [
+            (40, 1.0, 0.3),
+            (60, 1.0, 0.2),
+            (300, 4.0, 0.15),
+            (500, 10.0, 0.1),
+        ] {
+            let size = Vec2::new(side, side * 0.75);
+            let min = Vec2::new(-1.0, 2.0);
+            let space = Space::Periodic { min, size };
+            let positions: Vec<Vec2> = (0..n)
+                .map(|_| {
+                    min + Vec2::new(rng.random_range(0.0..size.x), rng.random_range(0.0..size.y))
+                })
+                .collect();
+            let radii: Vec<f32> = (0..n).map(|_| rng.random_range(0.01..r_max)).collect();
+            let mut pairs = Vec::new();
+            overlapping_pairs(
+                &mut CellList::default(),
+                space,
+                &positions,
+                &radii,
+                &mut pairs,
+            );
+            pairs.sort_unstable();
+            let expected = brute_force(space, &positions, &radii);
+            assert!(
+                expected
+                    .iter()
+                    .any(
+                        |&(i, j)| (positions[i as usize] - positions[j as usize]).length()
+                            > size.x / 2.0
+                    ),
+                "the case should include pairs across the seam"
+            );
+            assert_eq!(pairs, expected, "n = {n}, side = {side}");
         }
     }
 
@@ -183,7 +322,13 @@ mod tests {
     fn non_finite_positions_take_part_in_no_pair() {
         let positions = [Vec2::ZERO, Vec2::new(f32::NAN, 0.0), Vec2::new(0.1, 0.0)];
         let mut pairs = Vec::new();
-        overlapping_pairs(&mut CellList::default(), &positions, &[0.1; 3], &mut pairs);
+        overlapping_pairs(
+            &mut CellList::default(),
+            Space::Open,
+            &positions,
+            &[0.1; 3],
+            &mut pairs,
+        );
         assert_eq!(pairs, vec![(0, 2)]);
     }
 }

@@ -22,8 +22,9 @@ pub struct Body {
 pub struct ContactOutcome {
     /// Overlap depth before separation, as a fraction of the smaller radius (0 if apart).
     pub penetration: f32,
-    /// Whether an impulse was applied (the pair was approaching): a collision to count.
-    pub impulse: bool,
+    /// Magnitude of the impulse applied (0 if the pair was not approaching). Non-zero means a
+    /// collision to count; `(r_a + r_b) · impulse` summed over collisions gives the virial.
+    pub impulse: f32,
 }
 
 /// The contact normal from `a` to `b`. Coincident centres have no direction of their own; they
@@ -56,18 +57,18 @@ pub fn resolve_contact(a: &mut Body, b: &mut Body, restitution: f32) -> ContactO
         // Two immovable circles: nothing can move.
         return ContactOutcome {
             penetration: outcome_penetration,
-            impulse: false,
+            impulse: 0.0,
         };
     }
     a.position -= n * (overlap * a.inv_mass / total_inv_mass);
     b.position += n * (overlap * b.inv_mass / total_inv_mass);
 
     let approach = (b.velocity - a.velocity).dot(n);
-    let impulse = approach < 0.0;
-    if impulse {
-        let j = -(1.0 + restitution) * approach / total_inv_mass;
-        a.velocity -= n * (j * a.inv_mass);
-        b.velocity += n * (j * b.inv_mass);
+    let mut impulse = 0.0;
+    if approach < 0.0 {
+        impulse = -(1.0 + restitution) * approach / total_inv_mass;
+        a.velocity -= n * (impulse * a.inv_mass);
+        b.velocity += n * (impulse * b.inv_mass);
     }
     ContactOutcome {
         penetration: outcome_penetration,
@@ -92,7 +93,7 @@ mod tests {
     fn equal_masses_head_on_swap_velocities() {
         let (mut a, mut b) = (body(0.0, 0.0, 1.0, 0.0), body(0.9, 0.0, -2.0, 0.0));
         let out = resolve_contact(&mut a, &mut b, 1.0);
-        assert!(out.impulse);
+        assert_eq!(out.impulse, 3.0, "j = (1 + e)·|v_rel| / (2/m) = 2·3/2");
         assert!((out.penetration - 0.2).abs() < 1e-6);
         assert_eq!(a.velocity, Vec2::new(-2.0, 0.0));
         assert_eq!(b.velocity, Vec2::new(1.0, 0.0));
@@ -103,7 +104,7 @@ mod tests {
     fn separating_pairs_are_pushed_apart_but_keep_their_velocities() {
         let (mut a, mut b) = (body(0.0, 0.0, -1.0, 0.0), body(0.9, 0.0, 1.0, 0.0));
         let out = resolve_contact(&mut a, &mut b, 1.0);
-        assert!(!out.impulse);
+        assert_eq!(out.impulse, 0.0);
         assert_eq!(
             (a.velocity, b.velocity),
             (Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.0))

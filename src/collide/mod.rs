@@ -1,47 +1,41 @@
 //! Circle-circle collisions for the `discrete` solver: [`CollidePlugin`] gathers the circles into
 //! flat arrays, finds overlapping pairs with the [`broad_phase`] cell list, resolves each pair
-//! with the [`contact`] kernel in a fixed order, and scatters the result back.
+//! with the [`contact`] kernel in a fixed order, and scatters the result back. On a periodic
+//! arena pairs interact across the seam through the minimum image.
 
 pub mod broad_phase;
 pub mod contact;
 
 use bevy::prelude::*;
 
+use crate::boundary::wrap_into;
 use crate::components::{Mass, Position, Radius, Velocity};
+use crate::config::{Arena, Boundary, Effects};
 use crate::diagnostics::CollisionCounters;
-use crate::schedule::{CircleStep, CircleSystems};
-use broad_phase::{CellList, overlapping_pairs};
+use crate::effects::{Effect, schedule_effect};
+use broad_phase::{CellList, Space, overlapping_pairs};
 use contact::{Body, resolve_contact};
 
-/// Settings of circle-circle contact.
-#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq)]
-#[reflect(Resource, Debug)]
-pub struct CollisionSettings {
-    /// Coefficient of restitution: 1 is perfectly elastic, 0 perfectly inelastic.
-    pub restitution: f32,
-}
-
-/// Resolves overlaps between circles: separation plus elastic impulse, in
-/// [`CircleSystems::Collide`]. Leave it out (or disable it) and there is no broad phase at all.
-#[derive(Clone, Copy, Debug)]
-pub struct CollidePlugin {
-    /// Coefficient of restitution between circles.
-    pub restitution: f32,
-}
-
-impl Default for CollidePlugin {
-    fn default() -> Self {
-        Self { restitution: 1.0 }
-    }
-}
+/// Resolves overlaps between circles: separation plus restitution impulse (`effects.restitution`),
+/// in [`CircleSystems::Collide`](crate::CircleSystems). Leave it out (or disable it) and there is
+/// no broad phase at all.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CollidePlugin;
 
 impl Plugin for CollidePlugin {
     fn build(&self, app: &mut App) {
-        app.register_type::<CollisionSettings>()
-            .insert_resource(CollisionSettings {
-                restitution: self.restitution,
-            })
-            .add_systems(CircleStep, collide_circles.in_set(CircleSystems::Collide));
+        schedule_effect(app, Effect::Collisions);
+    }
+}
+
+/// The [`Space`] circles in `arena` collide in.
+pub fn collision_space(arena: &Arena, boundary: Boundary) -> Space {
+    match boundary {
+        Boundary::Walls => Space::Open,
+        Boundary::Periodic => Space::Periodic {
+            min: arena.min,
+            size: arena.size(),
+        },
     }
 }
 
@@ -55,10 +49,75 @@ pub struct ContactScratch {
     cells: CellList,
 }
 
-/// Finds and resolves all overlapping pairs (Gauss-Seidel: each pair sees the corrections of the
-/// pairs before it).
+impl ContactScratch {
+    /// The circles the next [`resolve_all_contacts`] works on (fill it first).
+    pub fn bodies_mut(&mut self) -> &mut Vec<Body> {
+        &mut self.bodies
+    }
+}
+
+/// What one collision pass found and did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassStats {
+    /// Pairs that were approaching and got an impulse.
+    pub collisions: u64,
+    /// Overlapping pairs found.
+    pub contacts: u64,
+    /// Deepest overlap, as a fraction of the smaller radius.
+    pub max_penetration: f32,
+    /// Sum of the overlaps (fractions of the smaller radius), for the mean.
+    pub penetration_sum: f64,
+    /// `Σ (r_a + r_b) · j` over collisions: the collisional virial.
+    pub virial: f64,
+}
+
+/// Finds and resolves all overlapping pairs among `bodies` (Gauss-Seidel: each pair sees the
+/// corrections of the pairs before it). The kernel of [`collide_circles`], usable without an App.
+pub fn resolve_all_contacts(
+    scratch: &mut ContactScratch,
+    space: Space,
+    restitution: f32,
+) -> PassStats {
+    let ContactScratch {
+        bodies,
+        positions,
+        radii,
+        pairs,
+        cells,
+    } = scratch;
+    positions.clear();
+    positions.extend(bodies.iter().map(|b| b.position));
+    radii.clear();
+    radii.extend(bodies.iter().map(|b| b.radius));
+    pairs.clear();
+    overlapping_pairs(cells, space, positions, radii, pairs);
+
+    let mut stats = PassStats::default();
+    for &(i, j) in pairs.iter() {
+        let [a, b] = bodies
+            .get_disjoint_mut([i as usize, j as usize])
+            .expect("broad phase yields distinct indices");
+        // Work on the image of `b` nearest to `a`; the shift is undone afterwards.
+        let shift = (b.position - a.position) - space.offset(a.position, b.position);
+        b.position -= shift;
+        let outcome = resolve_contact(a, b, restitution);
+        b.position += shift;
+        stats.contacts += u64::from(outcome.penetration > 0.0);
+        stats.max_penetration = stats.max_penetration.max(outcome.penetration);
+        stats.penetration_sum += f64::from(outcome.penetration);
+        if outcome.impulse > 0.0 {
+            stats.collisions += 1;
+            stats.virial += f64::from(a.radius + b.radius) * f64::from(outcome.impulse);
+        }
+    }
+    stats
+}
+
+/// Gathers the circles, resolves their contacts with [`resolve_all_contacts`] and writes back
+/// what changed.
 pub fn collide_circles(
-    settings: Res<CollisionSettings>,
+    arena: Res<Arena>,
+    effects: Res<Effects>,
     mut counters: ResMut<CollisionCounters>,
     mut scratch: Local<ContactScratch>,
     mut circles: Query<(&mut Position, &mut Velocity, &Radius, &Mass)>,
@@ -73,42 +132,21 @@ pub fn collide_circles(
             radius: r.0,
             inv_mass: m.inverse(),
         }));
-    scratch.positions.clear();
-    scratch
-        .positions
-        .extend(scratch.bodies.iter().map(|b| b.position));
-    scratch.radii.clear();
-    scratch
-        .radii
-        .extend(scratch.bodies.iter().map(|b| b.radius));
-    scratch.pairs.clear();
-    overlapping_pairs(
-        &mut scratch.cells,
-        &scratch.positions,
-        &scratch.radii,
-        &mut scratch.pairs,
-    );
-
-    let mut max_penetration = 0.0f32;
-    let mut impulses = 0u64;
-    for &(i, j) in &scratch.pairs {
-        let [a, b] = scratch
-            .bodies
-            .get_disjoint_mut([i as usize, j as usize])
-            .expect("broad phase yields distinct indices");
-        let outcome = resolve_contact(a, b, settings.restitution);
-        max_penetration = max_penetration.max(outcome.penetration);
-        impulses += u64::from(outcome.impulse);
-    }
-    counters.pair_collisions += impulses;
-    counters.max_penetration = counters.max_penetration.max(max_penetration);
-
-    if scratch.pairs.is_empty() {
+    let space = collision_space(&arena, effects.boundary);
+    let stats = resolve_all_contacts(scratch, space, effects.restitution);
+    counters.record_pass(&stats);
+    if stats.contacts == 0 {
         return;
     }
+    let periodic = effects.boundary == Boundary::Periodic;
     for ((mut p, mut v, _, _), body) in circles.iter_mut().zip(&scratch.bodies) {
-        if p.0 != body.position {
-            p.0 = body.position;
+        let position = if periodic && !arena.contains(body.position) {
+            wrap_into(body.position, &arena)
+        } else {
+            body.position
+        };
+        if p.0 != position {
+            p.0 = position;
         }
         if v.0 != body.velocity {
             v.0 = body.velocity;

@@ -25,6 +25,7 @@ impl Plugin for CirclesRenderPlugin {
         app.insert_resource(ClearColor(Color::srgb(0.02, 0.02, 0.03)))
             .add_plugins((hud::HudPlugin, input::InputPlugin))
             .add_systems(Startup, (create_disc_texture, spawn_camera_and_arena))
+            .add_systems(Update, fit_view_to_arena.run_if(resource_changed::<Arena>))
             .add_systems(
                 PostUpdate,
                 (attach_sprites, sync_transforms)
@@ -75,32 +76,50 @@ const VIEW_MARGIN: f32 = 1.04;
 /// Extra room above the arena for the HUD line, as a fraction of the arena height.
 const HUD_BAND: f32 = 0.07;
 
-fn spawn_camera_and_arena(mut commands: Commands, arena: Res<Arena>) {
+/// The camera projection and position that show `arena` whole, at its aspect ratio, with a
+/// band above it for the HUD.
+fn view_of(arena: &Arena) -> (Projection, Transform) {
     let size = arena.size();
-    commands.spawn((
-        Camera2d,
-        Projection::Orthographic(OrthographicProjection {
-            // AutoMin keeps the whole arena visible at its own aspect ratio whatever the window.
-            scaling_mode: ScalingMode::AutoMin {
-                min_width: size.x * VIEW_MARGIN,
-                min_height: size.y * (VIEW_MARGIN + HUD_BAND),
-            },
-            ..OrthographicProjection::default_2d()
-        }),
-        // Shift the view up by half the HUD band so the band sits above the arena.
-        Transform::from_translation(
-            (arena.center() + Vec2::Y * size.y * HUD_BAND / 2.0).extend(0.0),
-        ),
-    ));
+    let projection = Projection::Orthographic(OrthographicProjection {
+        // AutoMin keeps the whole arena visible at its own aspect ratio whatever the window.
+        scaling_mode: ScalingMode::AutoMin {
+            min_width: size.x * VIEW_MARGIN,
+            min_height: size.y * (VIEW_MARGIN + HUD_BAND),
+        },
+        ..OrthographicProjection::default_2d()
+    });
+    // Shift the view up by half the HUD band so the band sits above the arena.
+    let centre = arena.center() + Vec2::Y * size.y * HUD_BAND / 2.0;
+    (projection, Transform::from_translation(centre.extend(0.0)))
+}
+
+fn spawn_camera_and_arena(mut commands: Commands, arena: Res<Arena>) {
+    let (projection, transform) = view_of(&arena);
+    commands.spawn((Camera2d, projection, transform));
     commands.spawn((
         ArenaBackdrop,
         Sprite {
             color: Color::srgb(0.09, 0.1, 0.14),
-            custom_size: Some(size),
+            custom_size: Some(arena.size()),
             ..default()
         },
         Transform::from_translation(arena.center().extend(-1.0)),
     ));
+}
+
+type BackdropParts = (&'static mut Sprite, &'static mut Transform);
+
+/// Follows a changed arena (a reloaded scene): camera and backdrop.
+fn fit_view_to_arena(
+    arena: Res<Arena>,
+    mut camera: Single<(&mut Projection, &mut Transform), With<Camera2d>>,
+    mut backdrop: Single<BackdropParts, (With<ArenaBackdrop>, Without<Camera2d>)>,
+) {
+    let (projection, transform) = view_of(&arena);
+    *camera.0 = projection;
+    *camera.1 = transform;
+    backdrop.0.custom_size = Some(arena.size());
+    backdrop.1.translation = arena.center().extend(-1.0);
 }
 
 /// Gives every new circle its sprite.
@@ -155,27 +174,55 @@ Vulkan/GL driver). Use the headless commands instead (`moving_circles run --help
 app under a virtual display: `xvfb-run -a moving_circles` (Debian packages: xvfb, xauth, \
 mesa-vulkan-drivers).";
 
+/// How the app is opened besides its configuration.
+#[derive(Clone, Debug, Default)]
+pub struct AppOptions {
+    /// The scene file the configuration came from: watched and re-applied when it changes.
+    pub scene_file: Option<std::path::PathBuf>,
+    /// Render this many frames, save a PNG there and exit.
+    pub screenshot: Option<(std::path::PathBuf, u32)>,
+}
+
 /// The complete windowed app: Bevy's default plugins (as far as the enabled features go), the
-/// simulation, drawing, HUD and controls; with `screenshot = Some((path, frames))` it renders
-/// `frames` frames, saves the window and exits.
-pub fn app(
-    config: crate::config::CirclesConfig,
-    screenshot: Option<(std::path::PathBuf, u32)>,
-) -> App {
+/// simulation, drawing, HUD and controls, and hot reload of the scene file if there is one.
+pub fn app(config: crate::config::CirclesConfig, options: AppOptions) -> App {
+    use bevy::asset::io::AssetSourceBuilder;
+
     let mut app = App::new();
+    // The scene's folder becomes the `scene://` asset source, so any path works and is watched.
+    let watched = options.scene_file.as_ref().and_then(|path| {
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
+        let name = path.file_name()?.to_string_lossy().into_owned();
+        app.register_asset_source(
+            "scene",
+            AssetSourceBuilder::platform_default(&dir.to_string_lossy(), None),
+        );
+        Some(format!("scene://{name}"))
+    });
     app.add_plugins((
-        DefaultPlugins.set(WindowPlugin {
-            primary_window: Some(Window {
-                title: "moving circles".into(),
-                resolution: (1280, 720).into(),
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: Some(Window {
+                    title: "moving circles".into(),
+                    resolution: (1280, 720).into(),
+                    ..default()
+                }),
+                ..default()
+            })
+            .set(AssetPlugin {
+                watch_for_changes_override: Some(watched.is_some()),
                 ..default()
             }),
-            ..default()
-        }),
         crate::CirclesPlugins::new(config),
         CirclesRenderPlugin,
     ));
-    if let Some((path, frames)) = screenshot {
+    if let Some(asset_path) = watched {
+        app.add_plugins(crate::scene::asset::SceneReloadPlugin { asset_path });
+    }
+    if let Some((path, frames)) = options.screenshot {
         app.add_plugins(screenshot::ScreenshotPlugin { path, frames });
     }
     app

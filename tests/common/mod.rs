@@ -112,3 +112,30 @@ pub fn assert_relative(what: &str, actual: f64, expected: f64, tolerance: f64) {
         "{what}: expected {expected}, got {actual} (relative error {error:e} > {tolerance:e})"
     );
 }
+
+/// A headless app for a scene given as RON text (checked like a scene file).
+pub fn scene_app(ron: &str) -> App {
+    let config = Scene::parse(ron, "test scene")
+        .and_then(|s| s.to_config("test scene"))
+        .unwrap_or_else(|e| panic!("test scene does not load: {e}"));
+    create_app(config)
+}
+
+/// Short names of the systems in the simulation's schedules.
+pub fn system_names(app: &mut App) -> Vec<String> {
+    moving_circles::schedule::scheduled_systems(app)
+        .into_iter()
+        .map(|(_, s)| s.rsplit("::").next().unwrap().to_owned())
+        .collect()
+}
+
+/// Asserts that the schedule does (or does not) hold a system of this name.
+pub fn assert_scheduled(app: &mut App, system: &str, expected: bool) {
+    let names = system_names(app);
+    assert_eq!(
+        names.iter().any(|n| n == system),
+        expected,
+        "expected `{system}` {} the schedule; it holds {names:?}",
+        if expected { "in" } else { "absent from" }
+    );
+}

@@ -1,0 +1,204 @@
+//! Bad input gets a clear error naming the file, the line or field, and the problem: one test
+//! per kind of bad scene, and the command line's exit code and message for bad files and flags.
+
+use std::process::Command;
+
+use moving_circles::prelude::*;
+
+fn scene_error(ron: &str) -> String {
+    match Scene::parse(ron, "bad.ron").and_then(|s| s.to_config("bad.ron")) {
+        Ok(_) => panic!("scene should have been rejected:\n{ron}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn assert_starts(message: &str, expected: &str) {
+    assert!(
+        message.starts_with(expected),
+        "\nexpected: {expected}…\n     got: {message}"
+    );
+}
+
+#[test]
+fn a_syntax_error_names_line_and_column() {
+    assert_starts(
+        &scene_error("(\n  dt: 0.1,\n  spawn: (count: 3,,),\n)"),
+        "bad.ron: line 3, column",
+    );
+}
+
+#[test]
+fn an_unknown_field_is_named() {
+    let e = scene_error("(\n  efects: (collisions: false),\n)");
+    assert_starts(&e, "bad.ron: line 2");
+    assert!(e.contains("efects"), "{e}");
+}
+
+#[test]
+fn a_bad_solver_is_named() {
+    let e = scene_error("(solver: \"rk4\")");
+    assert!(e.contains("unknown solver `rk4`"), "{e}");
+}
+
+#[test]
+fn dt_must_be_positive_and_sane() {
+    for dt in ["0.0", "-0.01", "1e9"] {
+        assert_starts(
+            &scene_error(&format!("(dt: {dt})")),
+            "bad.ron: field `dt`: must be between",
+        );
+    }
+}
+
+#[test]
+fn the_arena_must_have_a_positive_finite_size() {
+    assert_starts(
+        &scene_error("(arena: (size: (0.0, 5.0)))"),
+        "bad.ron: field `arena.size`",
+    );
+}
+
+#[test]
+fn effect_parameters_are_checked() {
+    assert_starts(
+        &scene_error("(effects: (restitution: 1.5))"),
+        "bad.ron: field `effects.restitution`",
+    );
+    assert_starts(
+        &scene_error("(effects: (drag: -1.0))"),
+        "bad.ron: field `effects.drag`",
+    );
+    assert_starts(&scene_error("(mass: Equal(0.0))"), "bad.ron: field `mass`");
+}
+
+#[test]
+fn spawn_rules_are_checked_before_anything_is_allocated() {
+    assert_starts(
+        &scene_error("(spawn: (count: 1000000000))"),
+        "bad.ron: field `spawn.count`: asks for 1000000000",
+    );
+    assert_starts(
+        &scene_error("(spawn: (radius: (0.5, 0.1)))"),
+        "bad.ron: field `spawn.radius`",
+    );
+    assert_starts(
+        &scene_error("(spawn: (speed: (-1.0, 1.0)))"),
+        "bad.ron: field `spawn.speed`",
+    );
+    assert_starts(
+        &scene_error("(spawn: (area_fraction: 0.95))"),
+        "bad.ron: field `spawn.area_fraction`",
+    );
+}
+
+#[test]
+fn explicit_circles_are_checked_one_by_one() {
+    let circle = |fields: &str| {
+        scene_error(&format!(
+            "(circles: [(position: (0.0, 0.0), radius: 0.5), ({fields})])"
+        ))
+    };
+    assert_starts(
+        &circle("position: (1.0, 1.0), radius: -0.5"),
+        "bad.ron: field `circles[1].radius`: must be positive",
+    );
+    assert_starts(
+        &circle("position: (1.0, 1.0), radius: 0.5, mass: 0.0"),
+        "bad.ron: field `circles[1].mass`",
+    );
+    assert_starts(
+        &circle("position: (7.9, 1.0), radius: 0.5"),
+        "bad.ron: field `circles[1].position`: (7.9, 1) with radius 0.5 is not inside",
+    );
+    assert_starts(
+        &circle("position: (0.0, 0.0), radius: 5.0"),
+        "bad.ron: field `circles[1].radius`: 5 is larger than the arena",
+    );
+}
+
+#[test]
+fn overlapping_circles_are_an_error_unless_separation_is_asked_for() {
+    let overlap =
+        "circles: [(position: (0.0, 0.0), radius: 0.5), (position: (0.6, 0.0), radius: 0.5)]";
+    assert_starts(
+        &scene_error(&format!("({overlap})")),
+        "bad.ron: field `circles[1]`: overlaps circles[0] by",
+    );
+    let config = Scene::parse(&format!("(separate_overlaps: true, {overlap})"), "ok.ron")
+        .and_then(|s| s.to_config("ok.ron"))
+        .expect("separated");
+    let [a, b] = [config.circles[0], config.circles[1]];
+    assert!(a.position.distance(b.position) >= 1.0 - 1e-6, "{a:?} {b:?}");
+}
+
+#[test]
+fn touching_circles_are_accepted() {
+    let ok = Scene::parse(
+        "(circles: [(position: (0.1, 0.0), radius: 0.1), (position: (0.3, 0.0), radius: 0.1)])",
+        "t",
+    )
+    .and_then(|s| s.to_config("t"));
+    assert!(ok.is_ok(), "{ok:?}");
+}
+
+fn cli(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+        .args(args)
+        .output()
+        .expect("runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn the_command_line_fails_cleanly_on_bad_files_and_flags() {
+    let dir = std::env::temp_dir().join(format!("mc-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.txt");
+    std::fs::write(
+        &bad,
+        "2\n0.5 0.5 0 0 0.1 1 0 0 0\n0.5 0.5 0 inf 0.1 1 0 0 0\n",
+    )
+    .unwrap();
+    let bad = bad.to_str().unwrap();
+
+    let (ok, err) = cli(&["run", "--particles", bad, "--steps", "10"]);
+    assert!(!ok);
+    assert!(
+        err.contains(&format!("{bad}: line 3: vy must be finite")),
+        "{err}"
+    );
+
+    let (ok, err) = cli(&["run", "--particles", "/no/such/file.txt", "--steps", "10"]);
+    assert!(
+        !ok && err.contains("/no/such/file.txt: cannot read"),
+        "{err}"
+    );
+
+    let (ok, err) = cli(&["run", "--particles", bad, "--steps", "10", "--dt", "0"]);
+    assert!(
+        !ok && err.contains("--dt") && err.contains("must be between"),
+        "{err}"
+    );
+
+    let (ok, err) = cli(&["run", "--particles", bad]);
+    assert!(!ok && err.contains("--seconds"), "{err}");
+
+    let (ok, err) = cli(&[
+        "run",
+        "--scene",
+        "assets/scenes/classic.ron",
+        "--steps",
+        "1",
+        "--boundary",
+        "periodic",
+    ]);
+    assert!(
+        !ok && err.contains("--particles"),
+        "--boundary is for particle files: {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,174 @@
+//! The headless command line as other tools use it: `run` writes every report field, dumps the
+//! final state in the particle format, shows no progress bar when piped; `systems` lists what a
+//! scene schedules.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn moving_circles(args: &[&str]) -> (String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("runs");
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    );
+    assert!(out.status.success(), "{args:?} failed:\n{stderr}");
+    (stdout, stderr)
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mc-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+const REPORT_FIELDS: [&str; 17] = [
+    "n",
+    "solver",
+    "dt",
+    "steps",
+    "sim_seconds",
+    "wall_seconds",
+    "energy_initial",
+    "energy_final",
+    "energy_drift",
+    "momentum_initial",
+    "momentum_final",
+    "max_penetration",
+    "escaped",
+    "non_finite",
+    "pair_collisions",
+    "wall_collisions",
+    "z",
+];
+
+#[test]
+fn run_writes_every_report_field_and_dumps_the_final_state() {
+    let dir = temp_dir("run");
+    let report = dir.join("r.json");
+    let dump = dir.join("final.txt");
+    let (stdout, stderr) = moving_circles(&[
+        "run",
+        "--particles",
+        "tests/data/particles/billiards5.txt",
+        "--seconds",
+        "20",
+        "--report",
+        report.to_str().unwrap(),
+        "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("16 circles"), "{stdout}");
+    assert!(
+        stderr.is_empty(),
+        "no progress bar when piped, got: {stderr:?}"
+    );
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for field in REPORT_FIELDS {
+        assert!(json.get(field).is_some(), "report lacks `{field}`: {json}");
+    }
+    assert_eq!(json["n"], 16);
+    assert_eq!(json["steps"], 1200);
+    assert_eq!(json["solver"], "discrete");
+    assert!(json["wall_seconds"].as_f64().unwrap() > 0.0);
+    assert!(
+        json["pair_collisions"].as_u64().unwrap() > 0,
+        "the cue ball hits the rack"
+    );
+    assert!(json["energy_drift"].as_f64().unwrap().abs() < 0.1, "{json}");
+
+    let final_state =
+        moving_circles::scene::particles::read(&dump, moving_circles::prelude::Boundary::Walls)
+            .expect("the dump is a valid particle file");
+    assert_eq!(final_state.len(), 16);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn energy_drift_is_finite_when_nothing_moves() {
+    let dir = temp_dir("rest");
+    let input = dir.join("rest.txt");
+    std::fs::write(
+        &input,
+        "2\n0.25 0.5 0 0 0.1 1 9 9 9\n0.75 0.5 0 0 0.1 1 9 9 9\n",
+    )
+    .unwrap();
+    let report = dir.join("r.json");
+    moving_circles(&[
+        "run",
+        "--particles",
+        input.to_str().unwrap(),
+        "--steps",
+        "10",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["energy_drift"], 0.0);
+    assert!(
+        json["z"].is_null(),
+        "pressure is undefined without motion: {json}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn periodic_particle_runs_wrap_instead_of_bouncing() {
+    let dir = temp_dir("periodic");
+    let report = dir.join("r.json");
+    moving_circles(&[
+        "run",
+        "--particles",
+        "tests/data/particles/diagonal.txt",
+        "--boundary",
+        "periodic",
+        "--seconds",
+        "200",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["boundary"], "periodic");
+    assert_eq!(json["wall_collisions"], 0);
+    assert_eq!(json["escaped"], 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn systems_lists_what_each_scene_schedules() {
+    let listing = |scene: &str| {
+        moving_circles(&[
+            "systems",
+            "--scene",
+            &Path::new("assets/scenes").join(scene).to_string_lossy(),
+        ])
+        .0
+    };
+    let drift = listing("drift.ron");
+    let gas = listing("gas.ron");
+    assert!(
+        drift.lines().any(|l| l == "CircleStep integrate_positions"),
+        "{drift}"
+    );
+    assert!(
+        drift.lines().any(|l| l == "CircleStep bounce_off_walls"),
+        "{drift}"
+    );
+    assert!(
+        !drift.contains("collide_circles") && !drift.contains("wrap_around"),
+        "{drift}"
+    );
+    assert!(
+        gas.lines().any(|l| l == "CircleStep collide_circles"),
+        "{gas}"
+    );
+    assert!(gas.lines().any(|l| l == "CircleStep wrap_around"), "{gas}");
+    assert!(!gas.contains("bounce_off_walls"), "{gas}");
+}

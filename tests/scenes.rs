@@ -1,0 +1,152 @@
+//! The example scenes and particle files: each loads, runs, and schedules what it calls for;
+//! a scene applied at runtime (hot reload) swaps the effect systems.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use bevy::prelude::*;
+use common::*;
+use moving_circles::prelude::*;
+use moving_circles::scene::{asset::apply_config, particles};
+
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/scenes")
+        .join(format!("{name}.ron"))
+}
+
+const EXAMPLES: [&str; 7] = [
+    "classic",
+    "billiards",
+    "gas",
+    "brownian",
+    "gravity",
+    "drift",
+    "cradle",
+];
+
+#[test]
+fn every_example_scene_loads_and_runs_clean() {
+    for name in EXAMPLES {
+        let config = Scene::load(&scene_path(name)).unwrap_or_else(|e| panic!("{e}"));
+        let mut app = create_app(config);
+        step(&mut app, 20);
+        let d = *app.world().resource::<CircleDiagnostics>();
+        assert!(d.count > 0, "{name}: no circles");
+        assert_eq!((d.non_finite, d.escaped), (0, 0), "{name}: {d:?}");
+    }
+}
+
+#[test]
+fn the_app_default_is_the_classic_scene_file() {
+    let from_file = Scene::load(&scene_path("classic")).unwrap();
+    assert_eq!(moving_circles::scene::classic(), from_file);
+    assert_eq!(from_file.spawn.count, 32);
+    assert_eq!(from_file.spawn.mass, MassModel::Equal(1.0));
+    assert_eq!(from_file.arena.size(), Vec2::new(16.0, 9.0));
+}
+
+#[test]
+fn each_scene_schedules_exactly_its_effects() {
+    let expect = |name: &str, present: &[&str], absent: &[&str]| {
+        let mut app = create_app(Scene::load(&scene_path(name)).unwrap());
+        for system in present {
+            assert_scheduled(&mut app, system, true);
+        }
+        for system in absent {
+            assert_scheduled(&mut app, system, false);
+        }
+    };
+    let all = [
+        "apply_gravity",
+        "apply_drag",
+        "bounce_off_walls",
+        "wrap_around",
+        "collide_circles",
+    ];
+    let others = |present: &[&'static str]| -> Vec<&'static str> {
+        all.iter()
+            .copied()
+            .filter(|s| !present.contains(s))
+            .collect()
+    };
+    for (name, present) in [
+        ("drift", vec!["bounce_off_walls"]),
+        ("gas", vec!["wrap_around", "collide_circles"]),
+        (
+            "gravity",
+            vec!["apply_gravity", "bounce_off_walls", "collide_circles"],
+        ),
+        ("classic", vec!["bounce_off_walls", "collide_circles"]),
+    ] {
+        expect(name, &present, &others(&present));
+    }
+}
+
+#[test]
+fn the_gas_scene_is_ten_thousand_circles_at_three_tenths() {
+    let config = Scene::load(&scene_path("gas")).unwrap();
+    let mut app = create_app(config.clone());
+    let n = circles(&mut app).len();
+    assert!((9_500..=10_500).contains(&n), "{n} circles");
+    let area: f32 = circles(&mut app)
+        .iter()
+        .map(|c| std::f32::consts::PI * c.2 * c.2)
+        .sum();
+    assert!(
+        (area / config.arena.area() - 0.3).abs() < 0.01,
+        "area fraction {}",
+        area / config.arena.area()
+    );
+}
+
+#[test]
+fn applying_another_scene_at_runtime_swaps_the_effect_systems() {
+    let mut app = create_app(Scene::load(&scene_path("drift")).unwrap());
+    assert_scheduled(&mut app, "collide_circles", false);
+    let gas = Scene::load(&scene_path("gas")).unwrap();
+    apply_config(app.world_mut(), &gas);
+    app.update(); // the respawn runs in PreUpdate
+    assert_scheduled(&mut app, "collide_circles", true);
+    assert_scheduled(&mut app, "wrap_around", true);
+    assert_scheduled(&mut app, "bounce_off_walls", false);
+    step(&mut app, 5);
+    assert!(
+        app.world().resource::<CollisionCounters>().pair_collisions > 0,
+        "the new systems run"
+    );
+    assert!(circles(&mut app).len() > 9_000);
+
+    apply_config(app.world_mut(), &Scene::load(&scene_path("drift")).unwrap());
+    app.update();
+    assert_scheduled(&mut app, "collide_circles", false);
+    assert_scheduled(&mut app, "bounce_off_walls", true);
+    step(&mut app, 5);
+    assert_eq!(
+        app.world().resource::<CollisionCounters>().pair_collisions,
+        0
+    );
+}
+
+#[test]
+fn the_sample_particle_files_load_exactly() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/particles");
+    for (file, n) in [
+        ("billiards5.txt", 16),
+        ("wallbouncing.txt", 18),
+        ("diagonal.txt", 2),
+        ("p10.txt", 10),
+        ("brownian.txt", 1000),
+    ] {
+        let circles =
+            particles::read(&dir.join(file), Boundary::Walls).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(circles.len(), n, "{file}");
+        // Writing and reading back gives the same circles (f32 shortest round-trip decimals).
+        let again = particles::parse(&particles::format(&circles), file, Boundary::Walls).unwrap();
+        assert_eq!(again, circles, "{file}");
+    }
+    let brownian = particles::read(&dir.join("brownian.txt"), Boundary::Walls).unwrap();
+    assert_eq!((brownian[0].radius, brownian[0].mass), (0.1, 1.0));
+    assert_eq!(brownian[0].tint, [17, 247, 236]);
+}
