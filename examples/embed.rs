@@ -6,12 +6,13 @@
 use std::time::Duration;
 
 use bevy::app::ScheduleRunnerPlugin;
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::prelude::*;
 
 fn main() -> AppExit {
     let config = CirclesConfig {
-        arena: Arena::centered(Vec2::new(32.0, 18.0)),
+        arena: Arena::centered(DVec2::new(32.0, 18.0)),
         spawn: SpawnConfig {
             count: 2_000,
             radius: (0.08, 0.2),

@@ -6,6 +6,7 @@
 //! and its normal velocity flipped; one that is past a wall but already moving inward (pushed
 //! there by a collision) is only put back, so it cannot be flipped twice and stick to the wall.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::components::{Mass, Position, Radius, Velocity};
@@ -34,15 +35,15 @@ impl Plugin for PeriodicPlugin {
 }
 
 /// `p` moved into `[min, max)` on both axes by whole periods.
-pub fn wrap_into(p: Vec2, arena: &Arena) -> Vec2 {
+pub fn wrap_into(p: DVec2, arena: &Arena) -> DVec2 {
     let size = arena.size();
     let wrapped = arena.min + (p - arena.min).rem_euclid(size);
     // rem_euclid can round up to exactly `size`; that point is `min` again.
-    Vec2::select(wrapped.cmpge(arena.max), arena.min, wrapped)
+    DVec2::select(wrapped.cmpge(arena.max), arena.min, wrapped)
 }
 
 /// The shortest displacement from `a` to `b` on a periodic arena of this size (minimum image).
-pub fn minimum_image(d: Vec2, size: Vec2) -> Vec2 {
+pub fn minimum_image(d: DVec2, size: DVec2) -> DVec2 {
     d - size * (d / size).round()
 }
 
@@ -63,11 +64,11 @@ pub fn wrap_around(arena: Res<Arena>, mut circles: Query<&mut Position>) {
 /// back exactly as if it had bounced each time, so it always ends inside. A circle wider than
 /// the arena on an axis is centred on that axis and its velocity there zeroed: it cannot move.
 pub fn reflect_off_walls(
-    position: &mut Vec2,
-    velocity: &mut Vec2,
-    radius: f32,
+    position: &mut DVec2,
+    velocity: &mut DVec2,
+    radius: f64,
     arena: &Arena,
-    restitution: f32,
+    restitution: f64,
 ) -> u32 {
     let mut hits = 0;
     for axis in 0..2 {
@@ -82,7 +83,7 @@ pub fn reflect_off_walls(
     hits
 }
 
-fn reflect_axis(p: &mut f32, v: &mut f32, lo: f32, hi: f32) -> u32 {
+fn reflect_axis(p: &mut f64, v: &mut f64, lo: f64, hi: f64) -> u32 {
     if *p >= lo && *p <= hi {
         return 0;
     }
@@ -136,7 +137,7 @@ pub fn bounce_off_walls(
         let n = reflect_off_walls(&mut p, &mut v, radius.0, &arena, effects.wall_restitution);
         if n > 0 || p != position.0 {
             if n > 0 && mass.0.is_finite() {
-                impulse += f64::from(mass.0) * f64::from((v - velocity.0).length());
+                impulse += mass.0 * (v - velocity.0).length();
             }
             position.0 = p;
             velocity.0 = v;
@@ -153,74 +154,75 @@ mod tests {
 
     fn unit() -> Arena {
         Arena {
-            min: Vec2::ZERO,
-            max: Vec2::ONE,
+            min: DVec2::ZERO,
+            max: DVec2::ONE,
         }
     }
 
     #[test]
     fn overshoot_is_mirrored_and_velocity_flipped() {
-        let (mut p, mut v) = (Vec2::new(1.05, 0.5), Vec2::new(1.0, 0.2));
+        let (mut p, mut v) = (DVec2::new(1.05, 0.5), DVec2::new(1.0, 0.2));
         let hits = reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0);
         assert_eq!(hits, 1);
         assert!((p.x - 0.75).abs() < 1e-6, "{p}");
-        assert_eq!(v, Vec2::new(-1.0, 0.2));
+        assert_eq!(v, DVec2::new(-1.0, 0.2));
     }
 
     #[test]
     fn a_circle_already_moving_inward_is_put_back_not_flipped() {
-        let (mut p, mut v) = (Vec2::new(0.05, 0.5), Vec2::new(0.3, 0.0));
+        let (mut p, mut v) = (DVec2::new(0.05, 0.5), DVec2::new(0.3, 0.0));
         assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 0);
-        assert_eq!(p, Vec2::new(0.1, 0.5));
-        assert_eq!(v, Vec2::new(0.3, 0.0));
+        assert_eq!(p, DVec2::new(0.1, 0.5));
+        assert_eq!(v, DVec2::new(0.3, 0.0));
     }
 
     #[test]
     fn many_arena_widths_in_one_step_fold_back_inside() {
         // lo = 0.1, hi = 0.9, span 0.8: 3.3 past lo is 4 wall hits (even: same direction)
         // and 0.1 into the fifth span.
-        let (mut p, mut v) = (Vec2::new(3.4, 0.5), Vec2::new(5.0, 0.0));
+        let (mut p, mut v) = (DVec2::new(3.4, 0.5), DVec2::new(5.0, 0.0));
         assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 4);
         assert!((p.x - 0.2).abs() < 1e-5, "{p}");
         assert_eq!(v.x, 5.0);
         // 0.9 + 0.5 past hi: one hit, mirrored to 0.4, moving back.
-        let (mut p, mut v) = (Vec2::new(1.4, 0.5), Vec2::new(5.0, 0.0));
+        let (mut p, mut v) = (DVec2::new(1.4, 0.5), DVec2::new(5.0, 0.0));
         assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 1);
         assert!((p.x - 0.4).abs() < 1e-5, "{p}");
         assert_eq!(v.x, -5.0);
         // Past the low wall, moving out: one hit.
-        let (mut p, mut v) = (Vec2::new(-0.1, 0.5), Vec2::new(-5.0, 0.0));
+        let (mut p, mut v) = (DVec2::new(-0.1, 0.5), DVec2::new(-5.0, 0.0));
         assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0), 1);
         assert!((p.x - 0.3).abs() < 1e-5, "{p}");
         assert_eq!(v.x, 5.0);
-        let (mut p, mut v) = (Vec2::new(-1e7, 0.5), Vec2::new(-1e9, 0.0));
+        let (mut p, mut v) = (DVec2::new(-1e7, 0.5), DVec2::new(-1e9, 0.0));
         reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 1.0);
         assert!(unit().contains(p) && p.is_finite());
     }
 
     #[test]
     fn wall_restitution_scales_the_normal_velocity_per_hit() {
-        let (mut p, mut v) = (Vec2::new(1.05, 0.5), Vec2::new(2.0, 1.0));
+        let (mut p, mut v) = (DVec2::new(1.05, 0.5), DVec2::new(2.0, 1.0));
         reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 0.5);
-        assert_eq!(v, Vec2::new(-1.0, 1.0));
+        assert_eq!(v, DVec2::new(-1.0, 1.0));
     }
 
     #[test]
     fn wrapping_lands_inside_and_minimum_image_is_shortest() {
         let arena = unit();
         for p in [
-            Vec2::new(1.2, -0.3),
-            Vec2::new(-1e-9, 1.0),
-            Vec2::new(7.5, 3.25),
+            DVec2::new(1.2, -0.3),
+            DVec2::new(-1e-9, 1.0),
+            DVec2::new(7.5, 3.25),
         ] {
             let w = wrap_into(p, &arena);
             assert!(
-                w.cmpge(Vec2::ZERO).all() && w.cmplt(Vec2::ONE).all(),
+                w.cmpge(DVec2::ZERO).all() && w.cmplt(DVec2::ONE).all(),
                 "{p} → {w}"
             );
         }
         assert!(
-            (minimum_image(Vec2::new(0.9, -0.8), Vec2::ONE) - Vec2::new(-0.1, 0.2)).length() < 1e-6
+            (minimum_image(DVec2::new(0.9, -0.8), DVec2::ONE) - DVec2::new(-0.1, 0.2)).length()
+                < 1e-6
         );
     }
 }

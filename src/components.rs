@@ -3,30 +3,31 @@
 //! `Position` is deliberately not `Transform`: the simulation owns it, and the render side copies
 //! it into `Transform` only when rendering is on. Inserting a [`Radius`] is what makes an entity a
 //! circle; it brings the other components with it (`#[require]`), so
-//! `commands.spawn((Radius(0.5), Position(Vec2::ZERO)))` is a complete, resting, unit-mass circle.
+//! `commands.spawn((Radius(0.5), Position(DVec2::ZERO)))` is a complete, resting, unit-mass circle.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 /// Centre of a circle in arena coordinates.
 #[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Default, Debug)]
-pub struct Position(pub Vec2);
+pub struct Position(pub DVec2);
 
 /// Linear velocity in arena units per second.
 #[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Default, Debug)]
-pub struct Velocity(pub Vec2);
+pub struct Velocity(pub DVec2);
 
 /// Radius of a circle. Must be finite and positive; inserting it makes the entity a circle.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Debug)]
 #[require(Position, Velocity, Mass, Tint)]
-pub struct Radius(pub f32);
+pub struct Radius(pub f64);
 
-/// Mass of a circle. `f32::INFINITY` makes a circle immovable (its inverse mass is zero).
+/// Mass of a circle. `f64::INFINITY` makes a circle immovable (its inverse mass is zero).
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Default, Debug)]
-pub struct Mass(pub f32);
+pub struct Mass(pub f64);
 
 impl Default for Mass {
     fn default() -> Self {
@@ -37,7 +38,7 @@ impl Default for Mass {
 impl Mass {
     /// `1 / mass`, zero for an infinite mass. Collision kernels work with inverse masses so that
     /// immovable circles need no special case.
-    pub fn inverse(self) -> f32 {
+    pub fn inverse(self) -> f64 {
         if self.0.is_finite() {
             1.0 / self.0
         } else {
@@ -57,14 +58,14 @@ impl Default for Tint {
     }
 }
 
-impl From<Vec2> for Position {
-    fn from(v: Vec2) -> Self {
+impl From<DVec2> for Position {
+    fn from(v: DVec2) -> Self {
         Self(v)
     }
 }
 
-impl From<Vec2> for Velocity {
-    fn from(v: Vec2) -> Self {
+impl From<DVec2> for Velocity {
+    fn from(v: DVec2) -> Self {
         Self(v)
     }
 }

@@ -5,6 +5,7 @@
 use std::fmt;
 use std::str::FromStr;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -13,21 +14,21 @@ use serde::{Deserialize, Serialize};
 #[reflect(Resource, Debug)]
 pub struct Arena {
     /// Lower-left corner.
-    pub min: Vec2,
+    pub min: DVec2,
     /// Upper-right corner.
-    pub max: Vec2,
+    pub max: DVec2,
 }
 
 impl Default for Arena {
     /// A 16:9 arena, 16 units wide, centred on the origin (the seed's window shape).
     fn default() -> Self {
-        Self::centered(Vec2::new(16.0, 9.0))
+        Self::centered(DVec2::new(16.0, 9.0))
     }
 }
 
 impl Arena {
     /// An arena of the given size centred on the origin.
-    pub fn centered(size: Vec2) -> Self {
+    pub fn centered(size: DVec2) -> Self {
         Self {
             min: -size / 2.0,
             max: size / 2.0,
@@ -35,23 +36,23 @@ impl Arena {
     }
 
     /// Width and height.
-    pub fn size(&self) -> Vec2 {
+    pub fn size(&self) -> DVec2 {
         self.max - self.min
     }
 
     /// Area of the arena.
-    pub fn area(&self) -> f32 {
+    pub fn area(&self) -> f64 {
         let s = self.size();
         s.x * s.y
     }
 
     /// Centre of the arena.
-    pub fn center(&self) -> Vec2 {
+    pub fn center(&self) -> DVec2 {
         (self.min + self.max) / 2.0
     }
 
     /// Whether a point lies inside or on the boundary.
-    pub fn contains(&self, p: Vec2) -> bool {
+    pub fn contains(&self, p: DVec2) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
 }
@@ -63,10 +64,10 @@ pub enum MassModel {
     /// Mass proportional to area: `density · π r²`.
     Area {
         /// Mass per unit area.
-        density: f32,
+        density: f64,
     },
     /// Every circle has this mass (the seed's assumption).
-    Equal(f32),
+    Equal(f64),
 }
 
 impl Default for MassModel {
@@ -77,9 +78,9 @@ impl Default for MassModel {
 
 impl MassModel {
     /// The mass of a circle of radius `r` under this model.
-    pub fn mass_of(self, r: f32) -> f32 {
+    pub fn mass_of(self, r: f64) -> f64 {
         match self {
-            Self::Area { density } => density * std::f32::consts::PI * r * r,
+            Self::Area { density } => density * std::f64::consts::PI * r * r,
             Self::Equal(m) => m,
         }
     }
@@ -93,11 +94,11 @@ pub struct SpawnConfig {
     /// How many circles to place (ignored when `area_fraction` is set).
     pub count: usize,
     /// Fill this fraction of the arena's area instead of placing `count` circles.
-    pub area_fraction: Option<f32>,
+    pub area_fraction: Option<f64>,
     /// Smallest and largest radius; radii are drawn uniformly in between.
-    pub radius: (f32, f32),
+    pub radius: (f64, f64),
     /// Smallest and largest speed; directions are uniform.
-    pub speed: (f32, f32),
+    pub speed: (f64, f64),
     /// Seed of the random generator: the same seed gives the same circles.
     pub seed: u64,
     /// How masses are assigned.
@@ -130,7 +131,7 @@ impl SpawnConfig {
         };
         let (a, b) = self.radius;
         let mean_square = (a * a + a * b + b * b) / 3.0;
-        let n = fraction * arena.area() / (std::f32::consts::PI * mean_square);
+        let n = fraction * arena.area() / (std::f64::consts::PI * mean_square);
         if n.is_finite() && n > 0.0 {
             n.round() as usize
         } else {
@@ -242,13 +243,13 @@ pub struct Effects {
     /// Circle-circle collisions (broad phase, separation and impulse).
     pub collisions: bool,
     /// Constant acceleration, e.g. `(0, -9.81)`; `None` schedules no gravity system.
-    pub gravity: Option<Vec2>,
+    pub gravity: Option<DVec2>,
     /// Linear drag rate in 1/s (`v' = -drag · v`); `None` schedules no drag system.
-    pub drag: Option<f32>,
+    pub drag: Option<f64>,
     /// Coefficient of restitution between circles: 1 is perfectly elastic.
-    pub restitution: f32,
+    pub restitution: f64,
     /// Coefficient of restitution against the walls.
-    pub wall_restitution: f32,
+    pub wall_restitution: f64,
 }
 
 impl Default for Effects {

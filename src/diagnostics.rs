@@ -24,7 +24,7 @@ pub struct CollisionCounters {
     /// Overlapping pairs the collision passes found (each pass counts its own).
     pub contacts: u64,
     /// Deepest overlap the collision passes found, as a fraction of the smaller radius.
-    pub max_penetration: f32,
+    pub max_penetration: f64,
     /// Sum of the overlaps found, as fractions of the smaller radius.
     pub penetration_sum: f64,
     /// Momentum the walls took up, `Σ m |Δv|` over wall hits.
@@ -79,7 +79,7 @@ impl Pressure {
         if !(t > 0.0 && n > 0 && n_kt > 0.0) {
             return Self::default();
         }
-        let size = arena.size().as_dvec2();
+        let size = arena.size();
         let area = size.x * size.y;
         let perimeter = 2.0 * (size.x + size.y);
         Self {
@@ -149,18 +149,14 @@ impl Totals {
     /// Measures `(position, velocity, mass)` triples. Immovable (infinite-mass) circles carry no
     /// energy or momentum.
     pub fn measure(
-        circles: impl Iterator<Item = (Vec2, Vec2, f32)>,
+        circles: impl Iterator<Item = (DVec2, DVec2, f64)>,
         arena: &Arena,
-        gravity: Option<Vec2>,
+        gravity: Option<DVec2>,
     ) -> Self {
-        let g = gravity.unwrap_or(Vec2::ZERO).as_dvec2();
+        let g = gravity.unwrap_or(DVec2::ZERO);
         // Potential energy is measured from the arena's lowest corner along g, so it is never
         // negative and a relative drift stays meaningful.
-        let floor = DVec2::select(
-            g.cmpgt(DVec2::ZERO),
-            arena.max.as_dvec2(),
-            arena.min.as_dvec2(),
-        );
+        let floor = DVec2::select(g.cmpgt(DVec2::ZERO), arena.max, arena.min);
         let mut totals = Self::default();
         for (p, v, m) in circles {
             totals.count += 1;
@@ -172,7 +168,7 @@ impl Totals {
             if !m.is_finite() {
                 continue;
             }
-            let (p, v, m) = (p.as_dvec2(), v.as_dvec2(), f64::from(m));
+            let (p, v, m) = (p, v, m);
             totals.kinetic_energy += 0.5 * m * v.length_squared();
             totals.potential_energy += m * g.dot(floor - p);
             totals.momentum += m * v;

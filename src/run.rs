@@ -159,7 +159,7 @@ pub fn run_steps(app: &mut App, source: &str, steps: u64, mut progress: impl FnM
         energy_drift: relative_change(before.energy(), after.energy()),
         momentum_initial: before.momentum.to_array(),
         momentum_final: after.momentum.to_array(),
-        max_penetration: f64::from(counters.max_penetration),
+        max_penetration: counters.max_penetration,
         mean_penetration: counters.mean_penetration(),
         escaped: after.escaped,
         non_finite: after.non_finite,

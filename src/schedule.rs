@@ -40,7 +40,7 @@ pub struct CircleStep;
 
 /// The simulated time one run of [`CircleStep`] covers, in seconds (`dt / substeps`).
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
-pub struct StepDt(pub f32);
+pub struct StepDt(pub f64);
 
 /// The core plugin: inserts the arena, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
 /// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
@@ -103,7 +103,7 @@ impl Plugin for StepPlugin {
 pub fn run_circle_step(world: &mut World) {
     let substeps = world.resource::<Solver>().substeps();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
-    world.resource_mut::<StepDt>().0 = (dt / f64::from(substeps)) as f32;
+    world.resource_mut::<StepDt>().0 = dt / f64::from(substeps);
     for _ in 0..substeps {
         world.run_schedule(CircleStep);
     }

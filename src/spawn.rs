@@ -6,6 +6,7 @@
 //! second. Work is bounded: each circle gets `attempts_per_circle` tries; when an arena is full the
 //! remaining circles are skipped and the shortfall is reported, never looped on.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -18,13 +19,13 @@ use crate::schedule::CircleSystems;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CircleInit {
     /// Centre.
-    pub position: Vec2,
+    pub position: DVec2,
     /// Velocity.
-    pub velocity: Vec2,
+    pub velocity: DVec2,
     /// Radius.
-    pub radius: f32,
+    pub radius: f64,
     /// Mass.
-    pub mass: f32,
+    pub mass: f64,
     /// Colour.
     pub tint: [u8; 3],
 }
@@ -47,13 +48,13 @@ impl CircleInit {
 pub enum SpawnError {
     /// The radius range is empty, non-finite or not positive.
     #[error("spawn.radius: expected 0 < min <= max (finite), got ({0}, {1})")]
-    BadRadius(f32, f32),
+    BadRadius(f64, f64),
     /// The speed range is empty, non-finite or negative.
     #[error("spawn.speed: expected 0 <= min <= max (finite), got ({0}, {1})")]
-    BadSpeed(f32, f32),
+    BadSpeed(f64, f64),
     /// The arena has no area.
     #[error("arena: expected min < max on both axes, got min {0} max {1}")]
-    BadArena(Vec2, Vec2),
+    BadArena(DVec2, DVec2),
 }
 
 /// Places up to [`SpawnConfig::target_count`] non-overlapping circles inside `arena`, largest
@@ -82,13 +83,13 @@ pub fn place_circles(
     let count = config.target_count(arena);
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     // Largest first: big circles are the hard ones to fit once the arena fills up.
-    let mut radii: Vec<f32> = (0..count)
+    let mut radii: Vec<f64> = (0..count)
         .map(|_| rng.random_range(r_min..=r_max))
         .collect();
     radii.sort_by(|a, b| b.total_cmp(a));
 
     // Fixed circles can be larger than any random one; the grid's cells must span the largest.
-    let largest = fixed.iter().map(|c| c.radius).fold(r_max, f32::max);
+    let largest = fixed.iter().map(|c| c.radius).fold(r_max, f64::max);
     let mut grid = PlacementGrid::new(arena, largest, count + fixed.len());
     let mut placed: Vec<CircleInit> = Vec::with_capacity(count + fixed.len());
     for circle in fixed {
@@ -96,14 +97,14 @@ pub fn place_circles(
         placed.push(*circle);
     }
     for r in radii {
-        let lo = arena.min + Vec2::splat(r);
-        let hi = arena.max - Vec2::splat(r);
+        let lo = arena.min + DVec2::splat(r);
+        let hi = arena.max - DVec2::splat(r);
         if lo.x > hi.x || lo.y > hi.y {
             continue; // larger than the arena
         }
         let spot = (0..config.attempts_per_circle)
             .map(|_| {
-                Vec2::new(
+                DVec2::new(
                     sample_between(&mut rng, lo.x, hi.x),
                     sample_between(&mut rng, lo.y, hi.y),
                 )
@@ -111,11 +112,11 @@ pub fn place_circles(
             .find(|&p| !grid.overlaps_any(p, r, &placed));
         let Some(position) = spot else { continue };
         let speed = sample_between(&mut rng, s_min, s_max);
-        let angle = rng.random_range(0.0..std::f32::consts::TAU);
+        let angle = rng.random_range(0.0..std::f64::consts::TAU);
         grid.insert(position, placed.len());
         placed.push(CircleInit {
             position,
-            velocity: Vec2::from_angle(angle) * speed,
+            velocity: DVec2::from_angle(angle) * speed,
             radius: r,
             mass: config.mass.mass_of(r),
             tint: hue_to_rgb(rng.random_range(0.0..1.0)),
@@ -124,7 +125,7 @@ pub fn place_circles(
     Ok(placed.split_off(fixed.len()))
 }
 
-fn sample_between(rng: &mut impl Rng, lo: f32, hi: f32) -> f32 {
+fn sample_between(rng: &mut impl Rng, lo: f64, hi: f64) -> f64 {
     if lo < hi {
         rng.random_range(lo..=hi)
     } else {
@@ -133,7 +134,7 @@ fn sample_between(rng: &mut impl Rng, lo: f32, hi: f32) -> f32 {
 }
 
 /// A bright, saturated colour of the given hue in [0, 1).
-fn hue_to_rgb(hue: f32) -> [u8; 3] {
+fn hue_to_rgb(hue: f64) -> [u8; 3] {
     let h = hue * 6.0;
     let x = 1.0 - (h % 2.0 - 1.0).abs();
     let (r, g, b) = match h as u32 {
@@ -145,15 +146,15 @@ fn hue_to_rgb(hue: f32) -> [u8; 3] {
         _ => (1.0, 0.0, x),
     };
     // Lift towards white a little so dark blues stay visible on the dark arena.
-    let lift = |c: f32| (255.0 * (0.3 + 0.7 * c)).round() as u8;
+    let lift = |c: f64| (255.0 * (0.3 + 0.7 * c)).round() as u8;
     [lift(r), lift(g), lift(b)]
 }
 
 /// Circles placed so far, bucketed into square cells at least as wide as the largest diameter,
 /// so any overlap of a new circle is with a circle in its own or an adjacent cell.
 struct PlacementGrid {
-    origin: Vec2,
-    cell: f32,
+    origin: DVec2,
+    cell: f64,
     cols: usize,
     rows: usize,
     /// First circle in each cell (`u32::MAX` = none); `next` chains the rest.
@@ -162,12 +163,12 @@ struct PlacementGrid {
 }
 
 impl PlacementGrid {
-    fn new(arena: &Arena, r_max: f32, count: usize) -> Self {
+    fn new(arena: &Arena, r_max: f64, count: usize) -> Self {
         let size = arena.size();
         // Never more cells than about one per circle: a tiny radius in a big arena must not
         // allocate millions of empty cells. Cells span the largest diameter, so a 3×3 block
         // around a new circle holds every circle it could overlap.
-        let cell = (2.0 * r_max).max((size.x * size.y / count.max(1) as f32).sqrt());
+        let cell = (2.0 * r_max).max((size.x * size.y / count.max(1) as f64).sqrt());
         let cols = ((size.x / cell).ceil() as usize).max(1);
         let rows = ((size.y / cell).ceil() as usize).max(1);
         Self {
@@ -180,7 +181,7 @@ impl PlacementGrid {
         }
     }
 
-    fn cell_of(&self, p: Vec2) -> (usize, usize) {
+    fn cell_of(&self, p: DVec2) -> (usize, usize) {
         let c = ((p - self.origin) / self.cell).floor();
         (
             (c.x.max(0.0) as usize).min(self.cols - 1),
@@ -188,14 +189,14 @@ impl PlacementGrid {
         )
     }
 
-    fn insert(&mut self, p: Vec2, index: usize) {
+    fn insert(&mut self, p: DVec2, index: usize) {
         let (cx, cy) = self.cell_of(p);
         let slot = cy * self.cols + cx;
         self.next.push(self.head[slot]);
         self.head[slot] = index as u32;
     }
 
-    fn overlaps_any(&self, p: Vec2, r: f32, placed: &[CircleInit]) -> bool {
+    fn overlaps_any(&self, p: DVec2, r: f64, placed: &[CircleInit]) -> bool {
         let (cx, cy) = self.cell_of(p);
         for y in cy.saturating_sub(1)..=(cy + 1).min(self.rows - 1) {
             for x in cx.saturating_sub(1)..=(cx + 1).min(self.cols - 1) {
@@ -320,7 +321,7 @@ mod tests {
 
     #[test]
     fn a_full_arena_places_what_fits_and_stops() {
-        let arena = Arena::centered(Vec2::splat(2.0));
+        let arena = Arena::centered(DVec2::splat(2.0));
         let config = SpawnConfig {
             count: 1000,
             radius: (0.3, 0.3),
@@ -337,7 +338,7 @@ mod tests {
 
     #[test]
     fn a_circle_larger_than_the_arena_is_skipped() {
-        let arena = Arena::centered(Vec2::splat(1.0));
+        let arena = Arena::centered(DVec2::splat(1.0));
         let config = SpawnConfig {
             count: 3,
             radius: (0.6, 0.6),
@@ -356,7 +357,7 @@ mod tests {
         let err = place_circles(&arena, &bad_radius, &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.radius"), "{err}");
         let bad_speed = SpawnConfig {
-            speed: (f32::NAN, 1.0),
+            speed: (f64::NAN, 1.0),
             ..default()
         };
         let err = place_circles(&arena, &bad_speed, &[]).unwrap_err();

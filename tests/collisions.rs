@@ -3,6 +3,7 @@
 
 mod common;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
 use moving_circles::prelude::*;
@@ -12,15 +13,15 @@ fn a_head_on_equal_mass_hit_swaps_velocities() {
     let mut app = create_app(empty(CirclesConfig::default()));
     let a = spawn_circle(
         &mut app,
-        Vec2::new(-2.0, 0.0),
-        Vec2::new(3.0, 0.0),
+        DVec2::new(-2.0, 0.0),
+        DVec2::new(3.0, 0.0),
         0.5,
         1.0,
     );
     let b = spawn_circle(
         &mut app,
-        Vec2::new(2.0, 0.0),
-        Vec2::new(-1.0, 0.0),
+        DVec2::new(2.0, 0.0),
+        DVec2::new(-1.0, 0.0),
         0.5,
         1.0,
     );
@@ -33,7 +34,7 @@ fn a_head_on_equal_mass_hit_swaps_velocities() {
     );
     assert_eq!(
         (va, vb),
-        (Vec2::new(-1.0, 0.0), Vec2::new(3.0, 0.0)),
+        (DVec2::new(-1.0, 0.0), DVec2::new(3.0, 0.0)),
         "velocities must swap"
     );
 }
@@ -43,24 +44,21 @@ fn an_oblique_hit_of_unequal_masses_conserves_momentum_and_energy() {
     let mut app = create_app(empty(CirclesConfig::default()));
     spawn_circle(
         &mut app,
-        Vec2::new(-2.0, 0.3),
-        Vec2::new(2.5, 0.2),
+        DVec2::new(-2.0, 0.3),
+        DVec2::new(2.5, 0.2),
         0.5,
         1.0,
     );
     spawn_circle(
         &mut app,
-        Vec2::new(1.0, -0.2),
-        Vec2::new(-0.7, 0.4),
+        DVec2::new(1.0, -0.2),
+        DVec2::new(-0.7, 0.4),
         0.8,
         3.7,
     );
     let (e0, p0) = energy_momentum(&mut app);
     // Momentum components can nearly cancel, so their error is judged against Σ m|v|.
-    let scale: f64 = circles(&mut app)
-        .iter()
-        .map(|c| f64::from(c.3 * c.1.length()))
-        .sum();
+    let scale: f64 = circles(&mut app).iter().map(|c| c.3 * c.1.length()).sum();
     step(&mut app, 90);
     assert_eq!(
         app.world().resource::<CollisionCounters>().pair_collisions,
@@ -68,12 +66,12 @@ fn an_oblique_hit_of_unequal_masses_conserves_momentum_and_energy() {
         "one hit"
     );
     let (e1, p1) = energy_momentum(&mut app);
-    // The impulse is a handful of f32 operations on O(1) values: rounding is a few ulp of f32
-    // (≈1e-7 relative). 1e-6 leaves room for that and fails on any real modelling error.
-    assert_relative("kinetic energy", e1, e0, 1e-6);
+    // The impulse is a handful of f64 operations on O(1) values: rounding is a few ulp of f64
+    // (≈1e-16 relative). 1e-12 leaves ample room for that and fails on any modelling error.
+    assert_relative("kinetic energy", e1, e0, 1e-12);
     let momentum_error = (p1 - p0).length() / scale;
     assert!(
-        momentum_error <= 1e-6,
+        momentum_error <= 1e-12,
         "momentum changed by {momentum_error:e} of Σ m|v|: {p0} → {p1}"
     );
     let (v0, v1) = (circles(&mut app)[0].1, circles(&mut app)[1].1);
@@ -86,9 +84,15 @@ fn an_oblique_hit_of_unequal_masses_conserves_momentum_and_energy() {
 #[test]
 fn coincident_centres_never_produce_nan() {
     let mut app = create_app(empty(CirclesConfig::default()));
-    spawn_circle(&mut app, Vec2::new(1.0, 1.0), Vec2::ZERO, 0.5, 1.0);
-    spawn_circle(&mut app, Vec2::new(1.0, 1.0), Vec2::ZERO, 0.5, 1.0);
-    spawn_circle(&mut app, Vec2::new(1.0, 1.0), Vec2::new(1.0, 1.0), 0.3, 2.0);
+    spawn_circle(&mut app, DVec2::new(1.0, 1.0), DVec2::ZERO, 0.5, 1.0);
+    spawn_circle(&mut app, DVec2::new(1.0, 1.0), DVec2::ZERO, 0.5, 1.0);
+    spawn_circle(
+        &mut app,
+        DVec2::new(1.0, 1.0),
+        DVec2::new(1.0, 1.0),
+        0.3,
+        2.0,
+    );
     step(&mut app, 30);
     for (p, v, _, _) in circles(&mut app) {
         assert!(p.is_finite() && v.is_finite(), "non-finite state: {p} {v}");

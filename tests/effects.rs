@@ -3,6 +3,7 @@
 
 mod common;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
 
@@ -13,7 +14,7 @@ fn one_circle(effects: &str, boundary: &str, position: &str, velocity: &str) -> 
     ))
 }
 
-fn first_state(app: &mut App) -> (Vec2, Vec2) {
+fn first_state(app: &mut App) -> (DVec2, DVec2) {
     let c = circles(app)[0];
     (c.0, c.1)
 }
@@ -34,7 +35,7 @@ fn gravity_pulls_when_asked_and_is_absent_otherwise() {
     let mut app = one_circle("", "walls", "(0.0, 2.0)", "(0.0, 0.0)");
     assert_scheduled(&mut app, "apply_gravity", false);
     step(&mut app, 60);
-    assert_eq!(first_state(&mut app), (Vec2::new(0.0, 2.0), Vec2::ZERO));
+    assert_eq!(first_state(&mut app), (DVec2::new(0.0, 2.0), DVec2::ZERO));
 }
 
 #[test]
@@ -45,7 +46,7 @@ fn drag_slows_exponentially_when_asked_and_is_absent_otherwise() {
     let (_, v) = first_state(&mut app);
     assert_relative(
         "speed after 2 s of drag 0.5",
-        f64::from(v.x),
+        v.x,
         2.0 * (-1.0f64).exp(),
         1e-5,
     );
@@ -53,7 +54,7 @@ fn drag_slows_exponentially_when_asked_and_is_absent_otherwise() {
     let mut app = one_circle("", "walls", "(-4.0, 0.0)", "(2.0, 0.0)");
     assert_scheduled(&mut app, "apply_drag", false);
     step(&mut app, 120);
-    assert_eq!(first_state(&mut app).1, Vec2::new(2.0, 0.0));
+    assert_eq!(first_state(&mut app).1, DVec2::new(2.0, 0.0));
 }
 
 #[test]
@@ -65,7 +66,7 @@ fn periodic_edges_wrap_and_walls_reflect() {
     let (p, v) = first_state(&mut app);
     // 4.8 + 1.5 = 6.3 → wraps to -3.7, still moving right.
     assert!(
-        (p.x + 3.7).abs() < 1e-4 && v == Vec2::new(3.0, 0.0),
+        (p.x + 3.7).abs() < 1e-4 && v == DVec2::new(3.0, 0.0),
         "p = {p}, v = {v}"
     );
 
@@ -94,14 +95,14 @@ fn periodic_circles_collide_across_the_seam() {
     );
     assert_eq!(
         (cs[0].1, cs[1].1),
-        (Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.0)),
+        (DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0)),
         "they bounced off each other across the seam"
     );
 }
 
 #[test]
 fn restitution_below_one_loses_the_right_energy() {
-    let run = |e: f32| {
+    let run = |e: f64| {
         let mut app = scene_app(&format!(
             "(mass: Equal(1.0), effects: (restitution: {e}),
               circles: [(position: (-2.0, 0.0), velocity: (2.0, 0.0), radius: 0.5),
@@ -120,7 +121,7 @@ fn restitution_below_one_loses_the_right_energy() {
 fn wall_restitution_scales_the_rebound() {
     let mut app = one_circle("wall_restitution: 0.5", "walls", "(4.0, 0.0)", "(3.0, 1.0)");
     step(&mut app, 30);
-    assert_eq!(first_state(&mut app).1, Vec2::new(-1.5, 1.0));
+    assert_eq!(first_state(&mut app).1, DVec2::new(-1.5, 1.0));
 }
 
 #[test]

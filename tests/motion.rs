@@ -3,19 +3,22 @@
 
 mod common;
 
-use bevy::prelude::*;
+use bevy::math::DVec2;
 use common::*;
 use moving_circles::prelude::*;
+use moving_circles::schedule::StepDt;
 
 #[test]
 fn a_lone_circle_moves_exactly_v_dt_per_step() {
     let mut app = create_app(empty(CirclesConfig::default()));
-    let v = Vec2::new(1.25, -0.5);
-    let circle = spawn_circle(&mut app, Vec2::new(-1.0, 0.5), v, 0.3, 1.0);
-    let dt = (1.0f64 / 60.0) as f32;
-    let mut expected = Vec2::new(-1.0, 0.5);
+    let v = DVec2::new(1.25, -0.5);
+    let circle = spawn_circle(&mut app, DVec2::new(-1.0, 0.5), v, 0.3, 1.0);
+    let mut expected = DVec2::new(-1.0, 0.5);
     for _ in 0..60 {
         step(&mut app, 1);
+        // The fixed clock counts nanoseconds: dt is 1/60 s rounded to the nanosecond.
+        let dt = app.world().resource::<StepDt>().0;
+        assert!((dt - 1.0 / 60.0).abs() < 1e-9, "dt = {dt}");
         expected += v * dt;
         let (p, vel) = state(&app, circle);
         assert_eq!(p, expected, "position after one more step of dt = {dt}");
@@ -30,10 +33,10 @@ fn substeps_cover_the_same_time() {
         ..empty(CirclesConfig::default())
     };
     let mut app = create_app(config);
-    let circle = spawn_circle(&mut app, Vec2::ZERO, Vec2::new(2.0, 0.0), 0.3, 1.0);
+    let circle = spawn_circle(&mut app, DVec2::ZERO, DVec2::new(2.0, 0.0), 0.3, 1.0);
     step(&mut app, 30);
     let (p, _) = state(&app, circle);
-    // 4 × 30 additions of 2 · dt/4 in f32: half a second of flight, up to rounding.
+    // 4 × 30 additions of 2 · dt/4 in f64: half a second of flight, up to rounding.
     assert!(
         (p.x - 1.0).abs() < 1e-5,
         "expected x = 1.0 after 0.5 s, got {}",
@@ -46,8 +49,8 @@ fn a_wall_hit_reflects_and_stays_inside() {
     let arena = Arena::default();
     let mut app = create_app(empty(CirclesConfig::default()));
     let r = 0.4;
-    let v = Vec2::new(6.0, 1.5);
-    let circle = spawn_circle(&mut app, Vec2::new(arena.max.x - 1.0, 0.0), v, r, 1.0);
+    let v = DVec2::new(6.0, 1.5);
+    let circle = spawn_circle(&mut app, DVec2::new(arena.max.x - 1.0, 0.0), v, r, 1.0);
     let mut reflected = false;
     for _ in 0..600 {
         step(&mut app, 1);

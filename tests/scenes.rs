@@ -5,6 +5,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
 use moving_circles::prelude::*;
@@ -44,7 +45,7 @@ fn the_app_default_is_the_classic_scene_file() {
     assert_eq!(moving_circles::scene::classic(), from_file);
     assert_eq!(from_file.spawn.count, 32);
     assert_eq!(from_file.spawn.mass, MassModel::Equal(1.0));
-    assert_eq!(from_file.arena.size(), Vec2::new(16.0, 9.0));
+    assert_eq!(from_file.arena.size(), DVec2::new(16.0, 9.0));
 }
 
 #[test]
@@ -90,9 +91,9 @@ fn the_gas_scene_is_ten_thousand_circles_at_three_tenths() {
     let mut app = create_app(config.clone());
     let n = circles(&mut app).len();
     assert!((9_500..=10_500).contains(&n), "{n} circles");
-    let area: f32 = circles(&mut app)
+    let area: f64 = circles(&mut app)
         .iter()
-        .map(|c| std::f32::consts::PI * c.2 * c.2)
+        .map(|c| std::f64::consts::PI * c.2 * c.2)
         .sum();
     assert!(
         (area / config.arena.area() - 0.3).abs() < 0.01,
@@ -142,7 +143,7 @@ fn the_sample_particle_files_load_exactly() {
         let circles =
             particles::read(&dir.join(file), Boundary::Walls).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(circles.len(), n, "{file}");
-        // Writing and reading back gives the same circles (f32 shortest round-trip decimals).
+        // Writing and reading back gives the same circles (f64 shortest round-trip decimals).
         let again = particles::parse(&particles::format(&circles), file, Boundary::Walls).unwrap();
         assert_eq!(again, circles, "{file}");
     }

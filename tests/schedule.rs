@@ -5,6 +5,7 @@ mod common;
 
 use bevy::app::PluginGroup;
 use bevy::ecs::schedule::{LogLevel, ScheduleBuildSettings};
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
 use moving_circles::prelude::*;
@@ -91,20 +92,20 @@ fn without_collisions_there_is_no_collision_system() {
     }));
     spawn_circle(
         &mut app,
-        Vec2::new(-1.0, 0.0),
-        Vec2::new(1.0, 0.0),
+        DVec2::new(-1.0, 0.0),
+        DVec2::new(1.0, 0.0),
         0.5,
         1.0,
     );
     spawn_circle(
         &mut app,
-        Vec2::new(1.0, 0.0),
-        Vec2::new(-1.0, 0.0),
+        DVec2::new(1.0, 0.0),
+        DVec2::new(-1.0, 0.0),
         0.5,
         1.0,
     );
     step(&mut app, 120);
-    let xs: Vec<f32> = circles(&mut app).iter().map(|c| c.0.x).collect();
+    let xs: Vec<f64> = circles(&mut app).iter().map(|c| c.0.x).collect();
     assert!(
         xs[0] > 0.0 && xs[1] < 0.0,
         "without collisions the circles cross: {xs:?}"

@@ -3,12 +3,13 @@
 
 mod common;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
 use moving_circles::prelude::*;
 use moving_circles::spawn::place_circles;
 
-fn assert_valid_placement(arena: &Arena, placed: &[(Vec2, f32)]) {
+fn assert_valid_placement(arena: &Arena, placed: &[(DVec2, f64)]) {
     for (i, &(p, r)) in placed.iter().enumerate() {
         assert!(
             p.x - r >= arena.min.x
@@ -50,7 +51,7 @@ fn spawned_circles_never_overlap_and_stay_inside() {
 
 #[test]
 fn an_overfull_request_places_what_fits_and_reports_it() {
-    let arena = Arena::centered(Vec2::new(4.0, 3.0));
+    let arena = Arena::centered(DVec2::new(4.0, 3.0));
     let spawn = SpawnConfig {
         count: 5000,
         radius: (0.2, 0.3),

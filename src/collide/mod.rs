@@ -6,6 +6,7 @@
 pub mod broad_phase;
 pub mod contact;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::boundary::wrap_into;
@@ -43,8 +44,8 @@ pub fn collision_space(arena: &Arena, boundary: Boundary) -> Space {
 #[derive(Default)]
 pub struct ContactScratch {
     bodies: Vec<Body>,
-    positions: Vec<Vec2>,
-    radii: Vec<f32>,
+    positions: Vec<DVec2>,
+    radii: Vec<f64>,
     pairs: Vec<(u32, u32)>,
     cells: CellList,
 }
@@ -64,7 +65,7 @@ pub struct PassStats {
     /// Overlapping pairs found.
     pub contacts: u64,
     /// Deepest overlap, as a fraction of the smaller radius.
-    pub max_penetration: f32,
+    pub max_penetration: f64,
     /// Sum of the overlaps (fractions of the smaller radius), for the mean.
     pub penetration_sum: f64,
     /// `Σ (r_a + r_b) · j` over collisions: the collisional virial.
@@ -76,7 +77,7 @@ pub struct PassStats {
 pub fn resolve_all_contacts(
     scratch: &mut ContactScratch,
     space: Space,
-    restitution: f32,
+    restitution: f64,
 ) -> PassStats {
     let ContactScratch {
         bodies,
@@ -104,10 +105,10 @@ pub fn resolve_all_contacts(
         b.position += shift;
         stats.contacts += u64::from(outcome.penetration > 0.0);
         stats.max_penetration = stats.max_penetration.max(outcome.penetration);
-        stats.penetration_sum += f64::from(outcome.penetration);
+        stats.penetration_sum += outcome.penetration;
         if outcome.impulse > 0.0 {
             stats.collisions += 1;
-            stats.virial += f64::from(a.radius + b.radius) * f64::from(outcome.impulse);
+            stats.virial += (a.radius + b.radius) * outcome.impulse;
         }
     }
     stats

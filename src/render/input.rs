@@ -2,6 +2,7 @@
 //! quit, and dragging a circle to fling it. Keys map to plain actions on resources and messages,
 //! so the simulation itself knows nothing about input.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::components::{Position, Radius, Velocity};
@@ -104,9 +105,9 @@ fn quit(keys: Res<ButtonInput<KeyCode>>, mut exit: MessageWriter<AppExit>) {
 /// The circle being dragged, where it was grabbed and how fast the pointer moves.
 #[derive(Resource, Default, Debug)]
 pub struct Drag {
-    grabbed: Option<(Entity, Vec2)>,
-    last_cursor: Vec2,
-    velocity: Vec2,
+    grabbed: Option<(Entity, DVec2)>,
+    last_cursor: DVec2,
+    velocity: DVec2,
 }
 
 /// Left button on a circle grabs it; moving the mouse carries it; releasing lets it go with the
@@ -123,6 +124,7 @@ fn drag_and_fling(
     let Some(cursor) = window
         .cursor_position()
         .and_then(|p| camera.viewport_to_world_2d(camera_transform, p).ok())
+        .map(Vec2::as_dvec2)
     else {
         return;
     };
@@ -135,7 +137,7 @@ fn drag_and_fling(
         *drag = Drag {
             grabbed: hit,
             last_cursor: cursor,
-            velocity: Vec2::ZERO,
+            velocity: DVec2::ZERO,
         };
     }
     let Some((entity, offset)) = drag.grabbed else {
@@ -145,7 +147,7 @@ fn drag_and_fling(
         drag.grabbed = None;
         return;
     };
-    let dt = time.delta_secs();
+    let dt = time.delta_secs_f64();
     if dt > 0.0 {
         // Smooth the pointer velocity over a few frames so a release fling is not one noisy sample.
         let sample = (cursor - drag.last_cursor) / dt;

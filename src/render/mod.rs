@@ -79,7 +79,7 @@ const HUD_BAND: f32 = 0.07;
 /// The camera projection and position that show `arena` whole, at its aspect ratio, with a
 /// band above it for the HUD.
 fn view_of(arena: &Arena) -> (Projection, Transform) {
-    let size = arena.size();
+    let size = arena.size().as_vec2();
     let projection = Projection::Orthographic(OrthographicProjection {
         // AutoMin keeps the whole arena visible at its own aspect ratio whatever the window.
         scaling_mode: ScalingMode::AutoMin {
@@ -89,7 +89,7 @@ fn view_of(arena: &Arena) -> (Projection, Transform) {
         ..OrthographicProjection::default_2d()
     });
     // Shift the view up by half the HUD band so the band sits above the arena.
-    let centre = arena.center() + Vec2::Y * size.y * HUD_BAND / 2.0;
+    let centre = arena.center().as_vec2() + Vec2::Y * size.y * HUD_BAND / 2.0;
     (projection, Transform::from_translation(centre.extend(0.0)))
 }
 
@@ -100,10 +100,10 @@ fn spawn_camera_and_arena(mut commands: Commands, arena: Res<Arena>) {
         ArenaBackdrop,
         Sprite {
             color: Color::srgb(0.09, 0.1, 0.14),
-            custom_size: Some(arena.size()),
+            custom_size: Some(arena.size().as_vec2()),
             ..default()
         },
-        Transform::from_translation(arena.center().extend(-1.0)),
+        Transform::from_translation(arena.center().as_vec2().extend(-1.0)),
     ));
 }
 
@@ -118,8 +118,8 @@ fn fit_view_to_arena(
     let (projection, transform) = view_of(&arena);
     *camera.0 = projection;
     *camera.1 = transform;
-    backdrop.0.custom_size = Some(arena.size());
-    backdrop.1.translation = arena.center().extend(-1.0);
+    backdrop.0.custom_size = Some(arena.size().as_vec2());
+    backdrop.1.translation = arena.center().as_vec2().extend(-1.0);
 }
 
 /// Gives every new circle its sprite.
@@ -135,10 +135,10 @@ fn attach_sprites(
             Sprite {
                 image: disc.0.clone(),
                 color: Color::srgb_u8(r, g, b),
-                custom_size: Some(Vec2::splat(2.0 * radius.0)),
+                custom_size: Some(Vec2::splat(2.0 * radius.0 as f32)),
                 ..default()
             },
-            Transform::from_translation(position.0.extend(0.0)),
+            Transform::from_translation(position.0.as_vec2().extend(0.0)),
         ));
     }
 }
@@ -150,9 +150,9 @@ fn sync_transforms(
     circles
         .par_iter_mut()
         .for_each(|(position, radius, mut transform, mut sprite)| {
-            transform.translation = position.0.extend(0.0);
+            transform.translation = position.0.as_vec2().extend(0.0);
             if radius.is_changed() {
-                sprite.custom_size = Some(Vec2::splat(2.0 * radius.0));
+                sprite.custom_size = Some(Vec2::splat(2.0 * radius.0 as f32));
             }
         });
 }

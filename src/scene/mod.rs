@@ -22,6 +22,7 @@ pub mod particles;
 use std::fmt;
 use std::path::Path;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::Deserialize;
 
@@ -84,9 +85,9 @@ impl std::error::Error for InputError {}
 #[serde(default, deny_unknown_fields)]
 pub struct ArenaSpec {
     /// Width and height.
-    pub size: Vec2,
+    pub size: DVec2,
     /// Centre.
-    pub center: Vec2,
+    pub center: DVec2,
     /// `walls` or `periodic`.
     pub boundary: Boundary,
 }
@@ -94,8 +95,8 @@ pub struct ArenaSpec {
 impl Default for ArenaSpec {
     fn default() -> Self {
         Self {
-            size: Vec2::new(16.0, 9.0),
-            center: Vec2::ZERO,
+            size: DVec2::new(16.0, 9.0),
+            center: DVec2::ZERO,
             boundary: Boundary::Walls,
         }
     }
@@ -106,15 +107,15 @@ impl Default for ArenaSpec {
 #[serde(deny_unknown_fields)]
 pub struct CircleSpec {
     /// Centre.
-    pub position: Vec2,
+    pub position: DVec2,
     /// Velocity (default: at rest).
     #[serde(default)]
-    pub velocity: Vec2,
+    pub velocity: DVec2,
     /// Radius.
-    pub radius: f32,
+    pub radius: f64,
     /// Mass; by default from the scene's mass model.
     #[serde(default)]
-    pub mass: Option<f32>,
+    pub mass: Option<f64>,
     /// Colour as sRGB bytes; by default light grey.
     #[serde(default)]
     pub color: Option<[u8; 3]>,
@@ -290,7 +291,7 @@ impl Scene {
 }
 
 fn check_effects(effects: &Effects) -> Result<(), (&'static str, String)> {
-    let unit = |x: f32| x.is_finite() && (0.0..=1.0).contains(&x);
+    let unit = |x: f64| x.is_finite() && (0.0..=1.0).contains(&x);
     if !unit(effects.restitution) {
         return Err((
             "effects.restitution",
@@ -422,10 +423,10 @@ pub fn check_circle(
     Ok(())
 }
 
-/// How much two f32 coordinates near `p` can disagree by rounding alone: a few ulps of the
+/// How much two f64 coordinates near `p` can disagree by rounding alone: a few ulps of the
 /// largest magnitude involved. Touching within this is touching, not overlapping.
-pub fn rounding_slack(p: Vec2, radius: f32) -> f32 {
-    4.0 * f32::EPSILON * p.abs().max_element().max(radius)
+pub fn rounding_slack(p: DVec2, radius: f64) -> f64 {
+    4.0 * f64::EPSILON * p.abs().max_element().max(radius)
 }
 
 /// The first pair of circles that overlaps by more than rounding: `(i, j, depth)`.
@@ -433,10 +434,10 @@ pub fn first_overlap(
     circles: &[CircleInit],
     boundary: Boundary,
     arena: &Arena,
-) -> Option<(usize, usize, f32)> {
+) -> Option<(usize, usize, f64)> {
     use crate::collide::broad_phase::{CellList, overlapping_pairs};
-    let positions: Vec<Vec2> = circles.iter().map(|c| c.position).collect();
-    let radii: Vec<f32> = circles.iter().map(|c| c.radius).collect();
+    let positions: Vec<DVec2> = circles.iter().map(|c| c.position).collect();
+    let radii: Vec<f64> = circles.iter().map(|c| c.radius).collect();
     let space = crate::collide::collision_space(arena, boundary);
     let mut pairs = Vec::new();
     overlapping_pairs(
@@ -466,7 +467,7 @@ pub fn separate_overlaps(circles: &mut [CircleInit], arena: &Arena, boundary: Bo
         scratch.bodies_mut().clear();
         scratch.bodies_mut().extend(circles.iter().map(|c| Body {
             position: c.position,
-            velocity: Vec2::ZERO, // no impulses: only positions move
+            velocity: DVec2::ZERO, // no impulses: only positions move
             radius: c.radius,
             inv_mass: if c.mass.is_finite() {
                 1.0 / c.mass
@@ -477,7 +478,7 @@ pub fn separate_overlaps(circles: &mut [CircleInit], arena: &Arena, boundary: Bo
         let stats = resolve_all_contacts(&mut scratch, space, 1.0);
         for (c, b) in circles.iter_mut().zip(scratch.bodies_mut().iter()) {
             let mut p = b.position;
-            let mut v = Vec2::ZERO;
+            let mut v = DVec2::ZERO;
             match boundary {
                 Boundary::Walls => {
                     crate::boundary::reflect_off_walls(&mut p, &mut v, c.radius, arena, 1.0);

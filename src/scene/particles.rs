@@ -6,6 +6,7 @@
 use std::io::Write;
 use std::path::Path;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::{InputError, check_circle, first_overlap};
@@ -15,8 +16,8 @@ use crate::spawn::CircleInit;
 /// The arena of the particle format.
 pub fn unit_square() -> Arena {
     Arena {
-        min: Vec2::ZERO,
-        max: Vec2::ONE,
+        min: DVec2::ZERO,
+        max: DVec2::ONE,
     }
 }
 
@@ -101,7 +102,7 @@ fn parse_circle(line: &str) -> Result<CircleInit, String> {
             words.len()
         ));
     }
-    let mut x = [0.0f32; 6];
+    let mut x = [0.0f64; 6];
     for (k, slot) in x.iter_mut().enumerate() {
         let value: f64 = words[k]
             .parse()
@@ -109,7 +110,7 @@ fn parse_circle(line: &str) -> Result<CircleInit, String> {
         if !value.is_finite() {
             return Err(format!("{} must be finite, got `{}`", FIELDS[k], words[k]));
         }
-        *slot = value as f32;
+        *slot = value;
     }
     let mut rgb = [0u8; 3];
     for (k, slot) in rgb.iter_mut().enumerate() {
@@ -119,8 +120,8 @@ fn parse_circle(line: &str) -> Result<CircleInit, String> {
             .map_err(|_| format!("{} must be an integer 0-255, got `{word}`", FIELDS[6 + k]))?;
     }
     Ok(CircleInit {
-        position: Vec2::new(x[0], x[1]),
-        velocity: Vec2::new(x[2], x[3]),
+        position: DVec2::new(x[0], x[1]),
+        velocity: DVec2::new(x[2], x[3]),
         radius: x[4],
         mass: x[5],
         tint: rgb,

@@ -50,10 +50,10 @@ pub fn step(app: &mut App, n: u64) {
 /// Spawns one circle.
 pub fn spawn_circle(
     app: &mut App,
-    position: Vec2,
-    velocity: Vec2,
-    radius: f32,
-    mass: f32,
+    position: DVec2,
+    velocity: DVec2,
+    radius: f64,
+    mass: f64,
 ) -> Entity {
     app.world_mut()
         .spawn((
@@ -66,7 +66,7 @@ pub fn spawn_circle(
 }
 
 /// `(position, velocity)` of a circle.
-pub fn state(app: &App, entity: Entity) -> (Vec2, Vec2) {
+pub fn state(app: &App, entity: Entity) -> (DVec2, DVec2) {
     let e = app.world().entity(entity);
     (
         e.get::<Position>().unwrap().0,
@@ -75,7 +75,7 @@ pub fn state(app: &App, entity: Entity) -> (Vec2, Vec2) {
 }
 
 /// Every circle as `(position, velocity, radius, mass)`, in query order.
-pub fn circles(app: &mut App) -> Vec<(Vec2, Vec2, f32, f32)> {
+pub fn circles(app: &mut App) -> Vec<(DVec2, DVec2, f64, f64)> {
     app.world_mut()
         .query::<(&Position, &Velocity, &Radius, &Mass)>()
         .iter(app.world())
@@ -99,7 +99,7 @@ pub fn energy_momentum(app: &mut App) -> (f64, DVec2) {
     circles(app)
         .iter()
         .fold((0.0, DVec2::ZERO), |(e, p), &(_, v, _, m)| {
-            let (v, m) = (v.as_dvec2(), f64::from(m));
+            let (v, m) = (v, m);
             (e + 0.5 * m * v.length_squared(), p + m * v)
         })
 }
