@@ -149,15 +149,25 @@ pub enum Solver {
     Discrete,
     /// `Discrete` run `N` times per step with `dt / N`.
     Substeps(u32),
+    /// Continuous within each step: hits resolved in time order, bounded work per step.
+    Swept,
+    /// Event-driven across steps: every hit at its exact time; the reference.
+    Exact,
 }
 
 impl Solver {
     /// How many times the step schedule runs per fixed step.
     pub fn substeps(self) -> u32 {
         match self {
-            Self::Discrete => 1,
             Self::Substeps(n) => n.max(1),
+            _ => 1,
         }
+    }
+
+    /// Whether this solver advances time continuously (`swept`, `exact`) rather than by moving
+    /// and then fixing overlaps.
+    pub fn is_continuous(self) -> bool {
+        matches!(self, Self::Swept | Self::Exact)
     }
 }
 
@@ -166,13 +176,17 @@ impl fmt::Display for Solver {
         match self {
             Self::Discrete => write!(f, "discrete"),
             Self::Substeps(n) => write!(f, "substeps={n}"),
+            Self::Swept => write!(f, "swept"),
+            Self::Exact => write!(f, "exact"),
         }
     }
 }
 
 /// Why a solver name could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown solver `{0}`: expected `discrete` or `substeps=N` with N from 1 to 1024")]
+#[error(
+    "unknown solver `{0}`: expected `discrete`, `substeps=N` (N from 1 to 1024), `swept` or `exact`"
+)]
 pub struct ParseSolverError(pub String);
 
 impl FromStr for Solver {
@@ -182,6 +196,8 @@ impl FromStr for Solver {
         let err = || ParseSolverError(s.to_owned());
         match s.trim() {
             "discrete" => Ok(Self::Discrete),
+            "swept" => Ok(Self::Swept),
+            "exact" => Ok(Self::Exact),
             other => {
                 let n = other.strip_prefix("substeps=").ok_or_else(err)?;
                 match n.parse::<u32>() {
@@ -303,7 +319,13 @@ mod tests {
 
     #[test]
     fn solver_names_round_trip() {
-        for s in [Solver::Discrete, Solver::Substeps(1), Solver::Substeps(16)] {
+        for s in [
+            Solver::Discrete,
+            Solver::Substeps(1),
+            Solver::Substeps(16),
+            Solver::Swept,
+            Solver::Exact,
+        ] {
             assert_eq!(s.to_string().parse::<Solver>(), Ok(s));
         }
     }

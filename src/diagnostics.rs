@@ -21,12 +21,6 @@ pub struct CollisionCounters {
     pub pair_collisions: u64,
     /// Wall reflections.
     pub wall_collisions: u64,
-    /// Overlapping pairs the collision passes found (each pass counts its own).
-    pub contacts: u64,
-    /// Deepest overlap the collision passes found, as a fraction of the smaller radius.
-    pub max_penetration: f64,
-    /// Sum of the overlaps found, as fractions of the smaller radius.
-    pub penetration_sum: f64,
     /// Momentum the walls took up, `Σ m |Δv|` over wall hits.
     pub wall_impulse: f64,
     /// Collisional virial `Σ (r_a + r_b) · j` over circle-circle impulses.
@@ -37,19 +31,47 @@ impl CollisionCounters {
     /// Adds one collision pass.
     pub fn record_pass(&mut self, pass: &crate::collide::PassStats) {
         self.pair_collisions += pass.collisions;
-        self.contacts += pass.contacts;
-        self.max_penetration = self.max_penetration.max(pass.max_penetration);
-        self.penetration_sum += pass.penetration_sum;
         self.virial += pass.virial;
     }
+}
 
-    /// Mean overlap of the contacts found, as a fraction of the smaller radius (0 if none).
-    pub fn mean_penetration(&self) -> f64 {
-        if self.contacts == 0 {
-            0.0
-        } else {
-            self.penetration_sum / self.contacts as f64
+/// Overlaps in a state, each as a fraction of the pair's smaller radius.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Overlaps {
+    /// Overlapping pairs.
+    pub pairs: usize,
+    /// Deepest overlap.
+    pub max: f64,
+    /// Sum of the overlaps (for a mean over pairs).
+    pub sum: f64,
+}
+
+impl Overlaps {
+    /// Measures the overlaps of circles at `positions` with `radii` (broad phase, so O(N)).
+    pub fn measure(
+        positions: &[DVec2],
+        radii: &[f64],
+        space: crate::collide::broad_phase::Space,
+    ) -> Self {
+        use crate::collide::broad_phase::{CellList, overlapping_pairs};
+        let mut pairs = Vec::new();
+        overlapping_pairs(
+            &mut CellList::default(),
+            space,
+            positions,
+            radii,
+            &mut pairs,
+        );
+        let mut overlaps = Self::default();
+        for (i, j) in pairs {
+            let (i, j) = (i as usize, j as usize);
+            let depth = radii[i] + radii[j] - space.offset(positions[i], positions[j]).length();
+            let fraction = depth / radii[i].min(radii[j]);
+            overlaps.pairs += 1;
+            overlaps.max = overlaps.max.max(fraction);
+            overlaps.sum += fraction;
         }
+        overlaps
     }
 }
 

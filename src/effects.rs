@@ -3,7 +3,8 @@
 //! after a scene is hot-reloaded ([`reconcile_effects`] adds and removes systems).
 //! Also the two force effects themselves: gravity and linear drag.
 
-use bevy::ecs::schedule::{ScheduleCleanupPolicy, ScheduleConfigs};
+use bevy::ecs::intern::Interned;
+use bevy::ecs::schedule::{ScheduleCleanupPolicy, ScheduleConfigs, ScheduleLabel};
 use bevy::ecs::system::ScheduleSystem;
 use bevy::platform::collections::HashSet;
 use bevy::prelude::*;
@@ -12,7 +13,7 @@ use crate::boundary::{bounce_off_walls, wrap_around};
 use crate::collide::collide_circles;
 use crate::components::Velocity;
 use crate::config::{Boundary, Effects};
-use crate::schedule::{CircleStep, CircleSystems, StepDt};
+use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepDt};
 
 /// One schedulable effect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -57,7 +58,21 @@ impl Effect {
             .collect()
     }
 
-    /// This effect's systems, configured into their sets in [`CircleStep`].
+    /// The schedules this effect has systems in: forces act under every solver; walls,
+    /// periodic edges and collisions are the discrete solvers' (the continuous solvers handle
+    /// them inside their own step).
+    pub fn schedules(self) -> &'static [Interned<dyn ScheduleLabel>] {
+        static BOTH: std::sync::LazyLock<[Interned<dyn ScheduleLabel>; 2]> =
+            std::sync::LazyLock::new(|| [CircleStep.intern(), ContinuousStep.intern()]);
+        static DISCRETE: std::sync::LazyLock<[Interned<dyn ScheduleLabel>; 1]> =
+            std::sync::LazyLock::new(|| [CircleStep.intern()]);
+        match self {
+            Effect::Gravity | Effect::Drag => &*BOTH,
+            _ => &*DISCRETE,
+        }
+    }
+
+    /// This effect's systems, configured into their sets.
     pub fn systems(self) -> ScheduleConfigs<ScheduleSystem> {
         let set = EffectSystems(self);
         match self {
@@ -109,20 +124,27 @@ pub fn schedule_effect(app: &mut App, effect: Effect) {
 pub fn reconcile_effects(world: &mut World, effects: &Effects) {
     let wanted: HashSet<Effect> = Effect::called_for(effects).into_iter().collect();
     let scheduled = world.get_resource_or_init::<ScheduledEffects>().0.clone();
-    world.schedule_scope(CircleStep, |world, schedule| {
-        for &effect in scheduled.difference(&wanted) {
-            if let Err(e) = schedule.remove_systems_in_set(
-                EffectSystems(effect),
-                world,
-                ScheduleCleanupPolicy::RemoveSystemsOnly,
-            ) {
-                warn!("could not remove the {effect:?} systems: {e}");
+    for label in [CircleStep.intern(), ContinuousStep.intern()] {
+        world.schedule_scope(label, |world, schedule| {
+            for &effect in scheduled.difference(&wanted) {
+                if !effect.schedules().contains(&label) {
+                    continue;
+                }
+                if let Err(e) = schedule.remove_systems_in_set(
+                    EffectSystems(effect),
+                    world,
+                    ScheduleCleanupPolicy::RemoveSystemsOnly,
+                ) {
+                    warn!("could not remove the {effect:?} systems: {e}");
+                }
             }
-        }
-        for &effect in wanted.difference(&scheduled) {
-            schedule.add_systems(effect.systems());
-        }
-    });
+            for &effect in wanted.difference(&scheduled) {
+                if effect.schedules().contains(&label) {
+                    schedule.add_systems(effect.systems());
+                }
+            }
+        });
+    }
     world.resource_mut::<ScheduledEffects>().0 = wanted;
 }
 

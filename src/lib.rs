@@ -26,7 +26,8 @@
 //! - [`spawn`]: seeded non-overlapping placement.
 //! - [`integrate`]: `x += v·dt`.
 //! - [`boundary`]: wall reflection.
-//! - [`collide`]: broad phase (cell list), contact kernel, the collision system.
+//! - [`collide`]: broad phase (cell list), contact kernel, the collision system (`discrete`).
+//! - [`exact`]: the event-driven engine behind the `swept` and `exact` solvers.
 //! - [`diagnostics`]: energy, momentum, collision counters.
 //! - `render` (feature `render`): window, drawing, HUD, input, screenshots.
 #![warn(missing_docs)]
@@ -37,6 +38,7 @@ pub mod components;
 pub mod config;
 pub mod diagnostics;
 pub mod effects;
+pub mod exact;
 pub mod integrate;
 #[cfg(feature = "render")]
 pub mod render;
@@ -52,6 +54,7 @@ use collide::CollidePlugin;
 use config::CirclesConfig;
 use diagnostics::DiagnosticsPlugin;
 use effects::{DragPlugin, Effect, GravityPlugin};
+use exact::ContinuousPlugin;
 use integrate::IntegratePlugin;
 use schedule::StepPlugin;
 use spawn::SpawnPlugin;
@@ -67,9 +70,10 @@ pub mod prelude {
     };
     pub use crate::diagnostics::{CircleDiagnostics, CollisionCounters, DiagnosticsPlugin};
     pub use crate::effects::{DragPlugin, Effect, GravityPlugin};
+    pub use crate::exact::ContinuousPlugin;
     pub use crate::integrate::IntegratePlugin;
     pub use crate::scene::Scene;
-    pub use crate::schedule::{CircleStep, CircleSystems, StepPlugin};
+    pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin};
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
 }
 
@@ -126,6 +130,7 @@ impl PluginGroup for CirclesPlugins {
                 circles,
             })
             .add(IntegratePlugin)
+            .add(ContinuousPlugin)
             .add(DiagnosticsPlugin);
         for effect in Effect::called_for(&effects) {
             group = match effect {

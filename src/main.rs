@@ -48,7 +48,7 @@ struct AppArgs {
     /// Seed of the random placement (overrides the scene).
     #[arg(long)]
     seed: Option<u64>,
-    /// Solver: `discrete` or `substeps=N` (overrides the scene).
+    /// Solver: `discrete`, `substeps=N`, `swept` or `exact` (overrides the scene).
     #[arg(long)]
     solver: Option<Solver>,
     /// Render `--frames` frames, save the window to this PNG and exit.
@@ -69,7 +69,7 @@ struct RunArgs {
     /// Particle file: `N`, then `rx ry vx vy radius mass r g b` per line, in the unit square.
     #[arg(long, value_name = "PATH")]
     particles: Option<PathBuf>,
-    /// Solver: `discrete` or `substeps=N` (default: the scene's, or `discrete`).
+    /// Solver: `discrete`, `substeps=N`, `swept` or `exact` (default: the scene's, or `discrete`).
     #[arg(long)]
     solver: Option<Solver>,
     /// Boundary of a particle file's unit square: `walls` or `periodic`.
@@ -242,8 +242,17 @@ fn print_summary(r: &Report) {
 
 fn systems(scene: &Path) -> anyhow::Result<()> {
     let config = Scene::load(scene)?;
+    // Only the step schedule the scene's solver runs.
+    let idle_step = if config.solver.is_continuous() {
+        "CircleStep"
+    } else {
+        "ContinuousStep"
+    };
     let mut app = headless_app(config);
     for (schedule, system) in scheduled_systems(&mut app) {
+        if schedule == idle_step {
+            continue;
+        }
         let name = system.rsplit("::").next().unwrap_or(&system);
         println!("{schedule} {name}");
     }

@@ -30,6 +30,8 @@ pub enum CircleSystems {
     Boundary,
     /// Resolving circle-circle contacts (inside [`CircleStep`]).
     Collide,
+    /// Advancing a whole step continuously: `swept` / `exact` (inside [`ContinuousStep`]).
+    Continuous,
     /// Measuring energy, momentum and collision rates after the step (`FixedUpdate`).
     Diagnostics,
 }
@@ -37,6 +39,11 @@ pub enum CircleSystems {
 /// The schedule of one solver substep. Run by [`run_circle_step`] once per substep.
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CircleStep;
+
+/// The schedule of one step of the continuous solvers (`swept`, `exact`): the force effects,
+/// then [`CircleSystems::Continuous`], which handles motion, walls and collisions together.
+#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ContinuousStep;
 
 /// The simulated time one run of [`CircleStep`] covers, in seconds (`dt / substeps`).
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
@@ -81,6 +88,11 @@ impl Plugin for StepPlugin {
             .init_resource::<StepDt>()
             .init_resource::<CollisionCounters>()
             .init_schedule(CircleStep)
+            .init_schedule(ContinuousStep)
+            .configure_sets(
+                ContinuousStep,
+                (CircleSystems::Forces, CircleSystems::Continuous).chain(),
+            )
             .configure_sets(
                 CircleStep,
                 (
@@ -99,13 +111,20 @@ impl Plugin for StepPlugin {
     }
 }
 
-/// Advances one fixed step: runs [`CircleStep`] once per substep with the substep's `dt`.
+/// Advances one fixed step with the current [`Solver`]: runs [`CircleStep`] once per substep
+/// with the substep's `dt`, or [`ContinuousStep`] once.
 pub fn run_circle_step(world: &mut World) {
-    let substeps = world.resource::<Solver>().substeps();
+    let solver = *world.resource::<Solver>();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
-    world.resource_mut::<StepDt>().0 = dt / f64::from(substeps);
-    for _ in 0..substeps {
-        world.run_schedule(CircleStep);
+    if solver.is_continuous() {
+        world.resource_mut::<StepDt>().0 = dt;
+        world.run_schedule(ContinuousStep);
+    } else {
+        let substeps = solver.substeps();
+        world.resource_mut::<StepDt>().0 = dt / f64::from(substeps);
+        for _ in 0..substeps {
+            world.run_schedule(CircleStep);
+        }
     }
     let mut counters = world.resource_mut::<CollisionCounters>();
     counters.steps += 1;
@@ -113,7 +132,13 @@ pub fn run_circle_step(world: &mut World) {
 }
 
 /// The schedules the simulation adds systems to, in the order a frame meets them.
-pub const SIMULATION_SCHEDULES: [&str; 4] = ["Startup", "PreUpdate", "FixedUpdate", "CircleStep"];
+pub const SIMULATION_SCHEDULES: [&str; 5] = [
+    "Startup",
+    "PreUpdate",
+    "FixedUpdate",
+    "CircleStep",
+    "ContinuousStep",
+];
 
 /// The simulation's systems, as `(schedule, system)` names in execution order, for every
 /// schedule in [`SIMULATION_SCHEDULES`]. Only this crate's systems are listed. Initializes the

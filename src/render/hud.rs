@@ -35,7 +35,7 @@ r         reset (same seed)
 space     pause / resume
 .         one step (while paused)
 [ / ]     half / double speed
-1 / 2     solver: discrete / substeps=8
+1 2 3 4   solver: discrete / substeps=8 / swept / exact
 mouse     drag a circle to fling it
 h         this help
 q, Esc    quit";

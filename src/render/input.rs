@@ -89,10 +89,16 @@ fn single_step(world: &mut World) {
 }
 
 fn switch_solver(keys: Res<ButtonInput<KeyCode>>, mut solver: ResMut<Solver>) {
-    if keys.just_pressed(KeyCode::Digit1) {
-        *solver = Solver::Discrete;
-    } else if keys.just_pressed(KeyCode::Digit2) {
-        *solver = Solver::Substeps(8);
+    let chosen = [
+        (KeyCode::Digit1, Solver::Discrete),
+        (KeyCode::Digit2, Solver::Substeps(8)),
+        (KeyCode::Digit3, Solver::Swept),
+        (KeyCode::Digit4, Solver::Exact),
+    ]
+    .into_iter()
+    .find(|(key, _)| keys.just_pressed(*key));
+    if let Some((_, new)) = chosen {
+        *solver = new;
     }
 }
 

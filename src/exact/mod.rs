@@ -1,0 +1,144 @@
+//! The continuous solvers, `swept` and `exact`, built on one event-driven [`engine`]:
+//! - `exact` keeps one engine alive across steps (cost per collision, not per step) and only
+//!   rebuilds it when something outside changed the circles (a respawn, a drag with the mouse,
+//!   a force effect, a solver switch);
+//! - `swept` builds a fresh engine from the current state every step and resolves that step's
+//!   hits in time order, with a bounded number of events per step ([`SWEPT_EVENTS_PER_CIRCLE`]);
+//!   past the bound the rest of the step is free flight and the missed hits resolve next step.
+//!
+//! Both handle walls, periodic edges and collisions themselves, so they run in the
+//! [`ContinuousStep`](crate::schedule::ContinuousStep) schedule after the force effects.
+
+pub mod engine;
+pub mod toi;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::components::{Mass, Position, Radius, Velocity};
+use crate::config::{Arena, Boundary, Effects, Solver};
+use crate::diagnostics::CollisionCounters;
+use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
+use engine::{Bounds, Circle, EventEngine, EventStats};
+
+/// Events a `swept` step may process per circle before the rest of the step is free flight.
+pub const SWEPT_EVENTS_PER_CIRCLE: u64 = 64;
+/// The same bound for `exact`, high enough to be reached only by inelastic collapse.
+pub const EXACT_EVENTS_PER_CIRCLE: u64 = 100_000;
+
+/// Adds the `swept` / `exact` step to [`ContinuousStep`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ContinuousPlugin;
+
+impl Plugin for ContinuousPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<EngineState>().add_systems(
+            ContinuousStep,
+            advance_continuous.in_set(CircleSystems::Continuous),
+        );
+    }
+}
+
+/// The engine kept between `exact` steps, with what it last wrote to the ECS, so a change made
+/// by anything else can be detected.
+#[derive(Resource, Default)]
+pub struct EngineState {
+    engine: Option<EventEngine>,
+    entities: Vec<Entity>,
+    written: Vec<(DVec2, DVec2)>,
+    setup: Option<(Arena, Effects, Solver)>,
+    last_stats: EventStats,
+    /// Steps whose event budget ran out (their remainder was free flight).
+    pub budget_exhausted: u64,
+    /// Times the engine was rebuilt from the ECS state.
+    pub rebuilds: u64,
+}
+
+/// The engine's view of the arena.
+pub fn bounds_of(arena: &Arena, boundary: Boundary) -> Bounds {
+    match boundary {
+        Boundary::Walls => Bounds::Walls {
+            min: arena.min,
+            max: arena.max,
+        },
+        Boundary::Periodic => Bounds::Periodic {
+            min: arena.min,
+            size: arena.size(),
+        },
+    }
+}
+
+/// Advances one step with the `swept` or `exact` solver.
+#[allow(clippy::too_many_arguments)]
+pub fn advance_continuous(
+    solver: Res<Solver>,
+    arena: Res<Arena>,
+    effects: Res<Effects>,
+    dt: Res<StepDt>,
+    mut counters: ResMut<CollisionCounters>,
+    mut state: ResMut<EngineState>,
+    mut circles: Query<(Entity, &mut Position, &mut Velocity, &Radius, &Mass)>,
+) {
+    let state = &mut *state;
+    let setup = (*arena, *effects, *solver);
+    let unchanged = *solver == Solver::Exact
+        && state.engine.is_some()
+        && state.setup == Some(setup)
+        && circles.iter().len() == state.entities.len()
+        && circles
+            .iter()
+            .zip(state.entities.iter().zip(&state.written))
+            .all(|((e, p, v, _, _), (&we, &(wp, wv)))| e == we && p.0 == wp && v.0 == wv);
+    if !unchanged {
+        let bodies: Vec<Circle> = circles
+            .iter()
+            .map(|(_, p, v, r, m)| Circle {
+                position: p.0,
+                velocity: v.0,
+                radius: r.0,
+                inv_mass: m.inverse(),
+            })
+            .collect();
+        let engine = EventEngine::new(
+            &bodies,
+            bounds_of(&arena, effects.boundary),
+            effects.restitution,
+            effects.wall_restitution,
+        );
+        state.last_stats = engine.stats();
+        state.engine = Some(engine);
+        state.entities = circles.iter().map(|(e, ..)| e).collect();
+        state.setup = Some(setup);
+        state.rebuilds += 1;
+    }
+    let engine = state.engine.as_mut().expect("built above");
+    let per_circle = match *solver {
+        Solver::Swept => SWEPT_EVENTS_PER_CIRCLE,
+        _ => EXACT_EVENTS_PER_CIRCLE,
+    };
+    let budget = per_circle * (engine.len() as u64 + 1);
+    let t_end = engine.now() + dt.0;
+    if engine.advance_to(t_end, budget).is_err() {
+        engine.drift_to(t_end);
+        state.budget_exhausted += 1;
+    }
+
+    let stats = engine.stats();
+    let last = std::mem::replace(&mut state.last_stats, stats);
+    counters.pair_collisions += stats.pair_collisions - last.pair_collisions;
+    counters.wall_collisions += stats.wall_collisions - last.wall_collisions;
+    counters.wall_impulse += stats.wall_impulse - last.wall_impulse;
+    counters.virial += stats.virial - last.virial;
+
+    state.written.clear();
+    for (i, (_, mut p, mut v, _, _)) in circles.iter_mut().enumerate() {
+        let (position, velocity) = (engine.position(i), engine.velocity(i));
+        if p.0 != position {
+            p.0 = position;
+        }
+        if v.0 != velocity {
+            v.0 = velocity;
+        }
+        state.written.push((position, velocity));
+    }
+}
