@@ -32,6 +32,7 @@
 //! - `render` (feature `render`): window, drawing, HUD, input, screenshots.
 #![warn(missing_docs)]
 
+pub mod accuracy;
 pub mod boundary;
 pub mod collide;
 pub mod components;

@@ -27,6 +27,19 @@ struct Cli {
 enum Command {
     /// Run a scene or particle file headless and report (no window).
     Run(RunArgs),
+    /// Run the accuracy study: every solver and step on a set of scenes, measured against
+    /// `exact`; prints a table and writes accuracy.csv and accuracy.svg.
+    Accuracy {
+        /// Folder for accuracy.csv and accuracy.svg.
+        #[arg(long, value_name = "DIR", default_value = "out")]
+        out: PathBuf,
+        /// Folder the study's scenes (gas1k, gas, billiards, fast) are read from.
+        #[arg(long, value_name = "DIR", default_value = "assets/scenes")]
+        scenes: PathBuf,
+        /// One step size and shorter runs: a smoke test of the study, not a measurement.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Print the systems a scene schedules, one per line.
     Systems {
         /// The scene (RON).
@@ -69,9 +82,14 @@ struct RunArgs {
     /// Particle file: `N`, then `rx ry vx vy radius mass r g b` per line, in the unit square.
     #[arg(long, value_name = "PATH")]
     particles: Option<PathBuf>,
-    /// Solver: `discrete`, `substeps=N`, `swept` or `exact` (default: the scene's, or `discrete`).
+    /// Solver: `discrete`, `substeps=N`, `swept`, `exact`, or `auto` (the cheapest that meets
+    /// `--tolerance`, from a short calibration run). Default: the scene's, or `discrete`.
+    #[arg(long, value_parser = parse_solver_choice)]
+    solver: Option<SolverChoice>,
+    /// With `--solver auto`: the largest acceptable error, as the larger of the position error
+    /// against `exact` after a short calibration and the deepest overlap, both in radii.
     #[arg(long)]
-    solver: Option<Solver>,
+    tolerance: Option<f64>,
     /// Boundary of a particle file's unit square: `walls` or `periodic`.
     #[arg(long, value_parser = parse_boundary)]
     boundary: Option<Boundary>,
@@ -93,6 +111,22 @@ struct RunArgs {
     /// Write the final state here, in the particle format.
     #[arg(long, value_name = "PATH.txt")]
     dump: Option<PathBuf>,
+}
+
+/// A fixed solver, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum SolverChoice {
+    Fixed(Solver),
+    Auto,
+}
+
+fn parse_solver_choice(s: &str) -> Result<SolverChoice, String> {
+    if s == "auto" {
+        return Ok(SolverChoice::Auto);
+    }
+    s.parse()
+        .map(SolverChoice::Fixed)
+        .map_err(|e: moving_circles::config::ParseSolverError| format!("{e}, or `auto`"))
 }
 
 fn parse_boundary(s: &str) -> Result<Boundary, String> {
@@ -127,6 +161,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Run(args)) => run(args),
         Some(Command::Systems { scene }) => systems(&scene),
+        Some(Command::Accuracy { out, scenes, quick }) => accuracy(&out, &scenes, quick),
         None => return open_app(cli.app),
     };
     match result {
@@ -154,14 +189,39 @@ fn run(args: RunArgs) -> anyhow::Result<()> {
         }
         (None, None) => unreachable!("clap requires --scene or --particles"),
     };
-    if let Some(solver) = args.solver {
-        config.solver = solver;
-    }
     if let Some(dt) = args.dt {
         config.dt = dt;
     }
     if let Some(seed) = args.seed {
         config.spawn.seed = seed;
+    }
+    match (args.solver, args.tolerance) {
+        (Some(SolverChoice::Auto), Some(tolerance)) if tolerance.is_finite() && tolerance > 0.0 => {
+            let (choice, measured) = moving_circles::accuracy::choose_solver(&config, tolerance);
+            for c in &measured {
+                eprintln!(
+                    "auto: {:<12} error {:.2e}  {:.4} ms/step{}",
+                    c.solver.to_string(),
+                    c.error,
+                    c.ms_per_step,
+                    if c.solver == choice {
+                        "  <- chosen"
+                    } else {
+                        ""
+                    }
+                );
+            }
+            config.solver = choice;
+        }
+        (Some(SolverChoice::Auto), Some(t)) => {
+            bail!("--tolerance must be a positive number, got {t}")
+        }
+        (Some(SolverChoice::Auto), None) => {
+            bail!("--solver auto needs --tolerance X (the largest acceptable error, in radii)")
+        }
+        (_, Some(_)) => bail!("--tolerance goes with --solver auto"),
+        (Some(SolverChoice::Fixed(solver)), None) => config.solver = solver,
+        (None, None) => {}
     }
     let steps = match (args.steps, args.seconds) {
         (Some(0), _) => bail!("--steps must be at least 1"),
@@ -238,6 +298,42 @@ fn print_summary(r: &Report) {
         r.escaped,
         r.non_finite
     );
+}
+
+fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
+    use moving_circles::accuracy::{
+        compare, default_cases, plot, settings, to_csv, to_table, trace,
+    };
+
+    let cases = default_cases(scenes, quick)?;
+    let settings = settings(quick);
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let bar = indicatif::ProgressBar::new((cases.len() * (settings.len() + 1)) as u64).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {msg}")
+            .expect("valid template"),
+    );
+    let mut rows = Vec::new();
+    for case in &cases {
+        bar.set_message(format!("{}: exact reference", case.name));
+        let reference = trace(case, Solver::Exact, 1.0 / 60.0);
+        bar.inc(1);
+        for &(solver, dt) in &settings {
+            bar.set_message(format!("{}: {solver} at {:.0} Hz", case.name, 1.0 / dt));
+            rows.push(compare(case, &trace(case, solver, dt), &reference));
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    print!("{}", to_table(&rows));
+    let csv = out.join("accuracy.csv");
+    particles::write_atomically(&csv, &to_csv(&rows))
+        .with_context(|| format!("writing {}", csv.display()))?;
+    let svg = out.join("accuracy.svg");
+    let partial = out.join(".accuracy.svg.partial");
+    plot(&rows, &partial).map_err(|e| anyhow::anyhow!("drawing {}: {e}", svg.display()))?;
+    std::fs::rename(&partial, &svg).with_context(|| format!("writing {}", svg.display()))?;
+    println!("wrote {} and {}", csv.display(), svg.display());
+    Ok(())
 }
 
 fn systems(scene: &Path) -> anyhow::Result<()> {

@@ -14,6 +14,7 @@ use crate::components::{Mass, Position, Radius, Tint, Velocity};
 use crate::config::{Arena, Boundary, CirclesConfig, Effects};
 use crate::diagnostics::{CollisionCounters, Overlaps, Pressure, Totals, relative_change};
 use crate::effects::Effect;
+use crate::exact::EngineState;
 use crate::spawn::{CircleInit, SpawnReport};
 
 /// A headless app for `config`, past `Startup` (circles spawned), in which every `update()`
@@ -105,6 +106,8 @@ pub struct Report {
     pub z: Option<f64>,
     /// Compressibility factor from the momentum the walls took up (walls only).
     pub z_wall: Option<f64>,
+    /// Steps of `swept` / `exact` whose event budget ran out (rest of the step free flight).
+    pub budget_exhausted: u64,
 }
 
 /// Overlaps of the current state (see [`Overlaps`]).
@@ -194,5 +197,6 @@ pub fn run_steps(app: &mut App, source: &str, steps: u64, mut progress: impl FnM
         wall_collisions: counters.wall_collisions,
         z: pressure.z_virial,
         z_wall: pressure.z_wall,
+        budget_exhausted: world.resource::<EngineState>().budget_exhausted,
     }
 }

@@ -1,0 +1,101 @@
+//! The accuracy study and `--solver auto`: the study writes its CSV (every solver present) and
+//! plot; tunnelling is told apart from bouncing; `auto` picks cheap solvers for loose
+//! tolerances and an exact one for tight tolerances.
+
+use std::process::Command;
+
+use bevy::math::DVec2;
+use moving_circles::accuracy::{choose_solver, passed_through};
+use moving_circles::collide::broad_phase::Space;
+use moving_circles::prelude::*;
+use moving_circles::spawn::CircleInit;
+
+fn circle(x: f64, vx: f64) -> CircleInit {
+    CircleInit {
+        position: DVec2::new(x, 0.0),
+        velocity: DVec2::new(vx, 0.0),
+        radius: 0.1,
+        mass: 1.0,
+        tint: [0; 3],
+    }
+}
+
+#[test]
+fn passing_through_is_counted_and_bouncing_is_not() {
+    let before = [circle(-0.3, 6.0), circle(0.3, -6.0)];
+    // One step of 0.1 s later, unchanged velocities, on the far sides: tunnelled.
+    let tunnelled = [circle(0.3, 6.0), circle(-0.3, -6.0)];
+    assert_eq!(passed_through(&before, &tunnelled, Space::Open), 1);
+    // Bounced back: velocities changed, same sides.
+    let bounced = [circle(-0.3, -6.0), circle(0.3, 6.0)];
+    assert_eq!(passed_through(&before, &bounced, Space::Open), 0);
+    // Missed each other sideways: no overlap on the way.
+    let wide = [
+        CircleInit {
+            position: DVec2::new(-0.3, 0.5),
+            ..circle(0.0, 6.0)
+        },
+        circle(0.3, -6.0),
+    ];
+    let wide_after = [
+        CircleInit {
+            position: DVec2::new(0.3, 0.5),
+            ..circle(0.0, 6.0)
+        },
+        circle(-0.3, -6.0),
+    ];
+    assert_eq!(passed_through(&wide, &wide_after, Space::Open), 0);
+}
+
+fn fast_scene() -> CirclesConfig {
+    Scene::load(std::path::Path::new("assets/scenes/fast.ron")).unwrap()
+}
+
+#[test]
+fn auto_picks_a_continuous_solver_for_a_tight_tolerance_and_a_cheap_one_for_a_loose_one() {
+    let (tight, measured) = choose_solver(&fast_scene(), 1e-6);
+    assert!(
+        tight.is_continuous(),
+        "1e-6 of a radius needs swept or exact, got {tight}: {measured:?}"
+    );
+    assert_eq!(measured.len(), 7, "six candidates and exact");
+    // With any error allowed, the choice is the cheapest of that calibration's measurements.
+    let (loose, measured) = choose_solver(&fast_scene(), 1e6);
+    let cheapest = measured
+        .iter()
+        .min_by(|a, b| a.ms_per_step.total_cmp(&b.ms_per_step))
+        .unwrap();
+    assert_eq!(loose, cheapest.solver, "{measured:?}");
+}
+
+#[test]
+fn the_study_writes_a_csv_with_every_solver_and_a_plot() {
+    let out = std::env::temp_dir().join(format!("mc-accuracy-{}", std::process::id()));
+    let status = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["accuracy", "--quick", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("accuracy.csv")).unwrap();
+    for solver in ["discrete", "substeps=16", "swept", "exact"] {
+        for scene in ["gas1k", "gas", "billiards", "fast"] {
+            assert!(
+                csv.lines()
+                    .any(|l| l.starts_with(&format!("{scene},"))
+                        && l.contains(&format!(",{solver},"))),
+                "{scene}/{solver} missing:\n{csv}"
+            );
+        }
+    }
+    let svg = std::fs::read_to_string(out.join("accuracy.svg")).unwrap();
+    assert!(
+        svg.starts_with("<svg") && svg.contains("swept"),
+        "not a plot"
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+}
