@@ -107,7 +107,18 @@ impl Plugin for StepPlugin {
                 FixedUpdate,
                 (CircleSystems::Step, CircleSystems::Diagnostics).chain(),
             )
+            .add_systems(Startup, allow_long_steps)
             .add_systems(FixedUpdate, run_circle_step.in_set(CircleSystems::Step));
+    }
+}
+
+/// Lets virtual time advance by at least one fixed step per frame: Bevy caps a frame's virtual
+/// delta (250 ms by default), which would otherwise stop a scene with a longer `dt` (a 1 s
+/// step) from ever stepping.
+pub fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Virtual>>) {
+    let step = fixed.timestep();
+    if virt.max_delta() < step {
+        virt.set_max_delta(step);
     }
 }
 

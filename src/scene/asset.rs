@@ -64,6 +64,7 @@ pub fn apply_config(world: &mut World, config: &CirclesConfig) {
     world
         .resource_mut::<Time<Fixed>>()
         .set_timestep(Duration::from_secs_f64(config.dt));
+    let _ = world.run_system_cached(crate::schedule::allow_long_steps);
     reconcile_effects(world, &config.effects);
     world.write_message(Respawn);
 }

@@ -1,0 +1,128 @@
+//! Property tests of the numerical kernels with random inputs over many orders of magnitude:
+//! time of impact, the contact kernel (impulse + separation), wall reflection and the event
+//! engine. Each property is an invariant the code must keep for every input.
+
+use bevy::math::DVec2;
+use moving_circles::boundary::reflect_off_walls;
+use moving_circles::collide::contact::{Body, resolve_contact};
+use moving_circles::config::Arena;
+use moving_circles::exact::engine::{Bounds, Circle, EventEngine};
+use moving_circles::exact::toi::pair_time_of_impact;
+use proptest::prelude::*;
+
+/// A number with a random sign and a magnitude from 1e-6 to 1e6.
+fn wide() -> impl Strategy<Value = f64> {
+    (-6.0f64..6.0, any::<bool>())
+        .prop_map(|(e, neg)| if neg { -(10f64.powf(e)) } else { 10f64.powf(e) })
+}
+
+fn vector() -> impl Strategy<Value = DVec2> {
+    (wide(), wide()).prop_map(|(x, y)| DVec2::new(x, y))
+}
+
+fn positive() -> impl Strategy<Value = f64> {
+    (-4.0f64..4.0).prop_map(|e| 10f64.powf(e))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn time_of_impact_lands_on_contact_and_is_symmetric(dp in vector(), dv in vector(), sigma in positive()) {
+        let t = pair_time_of_impact(dp, dv, sigma);
+        // Swapping the pair flips both differences and must give the same answer.
+        prop_assert_eq!(t, pair_time_of_impact(-dp, -dv, sigma));
+        if let Some(t) = t {
+            prop_assert!(t.is_finite() && t >= 0.0);
+            if t > 0.0 {
+                let gap = (dp + dv * t).length();
+                // Relative to the scale of the inputs, the contact distance is σ up to rounding.
+                let scale = dp.length() + sigma;
+                prop_assert!((gap - sigma).abs() <= 1e-6 * scale, "gap {} vs sigma {}", gap, sigma);
+            }
+        }
+    }
+
+    #[test]
+    fn contacts_conserve_momentum_and_energy_and_leave_no_approach_or_overlap(
+        pa in vector(), off in vector(), va in vector(), vb in vector(),
+        ra in positive(), rb in positive(), ma in positive(), mb in positive(),
+    ) {
+        let mut a = Body { position: pa, velocity: va, radius: ra, inv_mass: 1.0 / ma };
+        // Put b within reach of a, so the pair overlaps (the interesting case).
+        let reach = (ra + rb) * 0.999;
+        let mut b = Body { position: pa + off.normalize_or(DVec2::X) * (reach * 0.5), velocity: vb, radius: rb, inv_mass: 1.0 / mb };
+        let (a0, b0) = (a, b);
+        let p0 = va * ma + vb * mb;
+        let e0 = 0.5 * ma * va.length_squared() + 0.5 * mb * vb.length_squared();
+        resolve_contact(&mut a, &mut b, 1.0);
+        for x in [a.position, a.velocity, b.position, b.velocity] {
+            prop_assert!(x.is_finite());
+        }
+        let p1 = a.velocity * ma + b.velocity * mb;
+        let e1 = 0.5 * ma * a.velocity.length_squared() + 0.5 * mb * b.velocity.length_squared();
+        let p_scale = ma * va.length() + mb * vb.length();
+        prop_assert!((p1 - p0).length() <= 1e-9 * p_scale, "momentum {} → {}", p0, p1);
+        prop_assert!((e1 - e0).abs() <= 1e-9 * e0, "energy {} → {}", e0, e1);
+        let d = b.position - a.position;
+        prop_assert!(d.length() >= (ra + rb) * (1.0 - 1e-9) - 1e-9 * pa.length(), "still overlapping");
+        let n = d.normalize_or(DVec2::X);
+        prop_assert!((b.velocity - a.velocity).dot(n) >= -1e-9 * (va.length() + vb.length()), "still approaching");
+
+        // Swapping the pair gives the mirrored result.
+        let (mut a2, mut b2) = (b0, a0);
+        resolve_contact(&mut a2, &mut b2, 1.0);
+        prop_assert!((a2.velocity - b.velocity).length() <= 1e-9 * p_scale / ma.min(mb));
+        prop_assert!((b2.velocity - a.velocity).length() <= 1e-9 * p_scale / ma.min(mb));
+    }
+
+    #[test]
+    fn walls_keep_every_circle_inside_with_its_speed(p in vector(), v in vector(), r in 0.001f64..0.4) {
+        let arena = Arena { min: DVec2::new(-1.0, -1.0), max: DVec2::new(1.0, 1.0) };
+        let (mut q, mut w) = (p, v);
+        reflect_off_walls(&mut q, &mut w, r, &arena, 1.0);
+        prop_assert!(q.is_finite() && w.is_finite());
+        prop_assert!(q.cmpge(arena.min + r).all() && q.cmple(arena.max - r).all(), "{} ended at {}", p, q);
+        prop_assert_eq!(w.abs(), v.abs());
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn the_event_engine_conserves_energy_and_never_overlaps(
+        seeds in prop::collection::vec((0.05f64..0.95, 0.05f64..0.95, -1.0f64..1.0, -1.0f64..1.0, 0.005f64..0.03, 0.1f64..10.0), 2..40),
+        periodic in any::<bool>(),
+    ) {
+        // Keep only circles that do not overlap the ones before them.
+        let mut circles: Vec<Circle> = Vec::new();
+        for (x, y, vx, vy, r, m) in seeds {
+            let p = DVec2::new(x, y);
+            if circles.iter().all(|c| c.position.distance(p) > c.radius + r) {
+                circles.push(Circle { position: p, velocity: DVec2::new(vx, vy), radius: r, inv_mass: 1.0 / m });
+            }
+        }
+        let bounds = if periodic {
+            Bounds::Periodic { min: DVec2::ZERO, size: DVec2::ONE }
+        } else {
+            Bounds::Walls { min: DVec2::ZERO, max: DVec2::ONE }
+        };
+        let energy = |e: &EventEngine| (0..e.len()).map(|i| 0.5 / circles[i].inv_mass * e.velocity(i).length_squared()).sum::<f64>();
+        let mut engine = EventEngine::new(&circles, bounds, 1.0, 1.0);
+        let e0 = energy(&engine);
+        for step in 1..=20 {
+            prop_assert!(engine.advance_to(step as f64 * 0.05, u64::MAX).is_ok());
+            for i in 0..engine.len() {
+                for j in i + 1..engine.len() {
+                    let mut d = engine.position(j) - engine.position(i);
+                    if periodic {
+                        d -= d.round();
+                    }
+                    prop_assert!(d.length() >= (circles[i].radius + circles[j].radius) * (1.0 - 1e-9), "overlap after step {}", step);
+                }
+            }
+        }
+        prop_assert!((energy(&engine) - e0).abs() <= 1e-12 * e0.max(1e-300));
+    }
+}
