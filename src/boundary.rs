@@ -43,8 +43,25 @@ pub fn wrap_into(p: DVec2, arena: &Arena) -> DVec2 {
 }
 
 /// The shortest displacement from `a` to `b` on a periodic arena of this size (minimum image).
+///
+/// Displacements between wrapped positions are within one box size, which one conditional
+/// shift per axis handles; anything larger falls back to rounding (`round` is a libm call,
+/// and this sits in the innermost loop of the periodic broad phase).
+#[inline]
 pub fn minimum_image(d: DVec2, size: DVec2) -> DVec2 {
-    d - size * (d / size).round()
+    let half = size * 0.5;
+    let mut r = d;
+    for axis in 0..2 {
+        if r[axis] > half[axis] {
+            r[axis] -= size[axis];
+        } else if r[axis] < -half[axis] {
+            r[axis] += size[axis];
+        }
+        if r[axis].abs() > half[axis] {
+            return d - size * (d / size).round();
+        }
+    }
+    r
 }
 
 /// Wraps every circle's centre back into the arena.

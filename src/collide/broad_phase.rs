@@ -20,6 +20,8 @@ pub struct CellList {
     start: Vec<u32>,
     order: Vec<u32>,
     cell_of: Vec<u32>,
+    /// Positions and radii in `order`, reused by [`overlapping_pairs`].
+    sorted: Vec<(DVec2, f64)>,
 }
 
 /// No cell: the circle has a non-finite position and takes part in no pair.
@@ -130,8 +132,13 @@ impl CellList {
     }
 
     fn cell(&self, x: usize, y: usize) -> &[u32] {
+        &self.order[self.range(x, y)]
+    }
+
+    /// Positions in [`Self::order`] of the circles in cell `(x, y)`.
+    fn range(&self, x: usize, y: usize) -> std::ops::Range<usize> {
         let c = y * self.cols + x;
-        &self.order[self.start[c] as usize..self.start[c + 1] as usize]
+        self.start[c] as usize..self.start[c + 1] as usize
     }
 
     fn half_stencil(&self, x: usize, y: usize) -> [Option<(usize, usize)>; 4] {
@@ -206,6 +213,9 @@ impl Space {
 
 /// Appends to `pairs` every pair `(i, j)`, `i < j`, of circles that overlap (centre distance
 /// below the sum of radii), found through `cells`. The order depends only on the input.
+///
+/// The scan runs over copies of the positions and radii laid out in cell order, so the inner
+/// loops read contiguous memory instead of jumping through the circles in entity order.
 pub fn overlapping_pairs(
     cells: &mut CellList,
     space: Space,
@@ -221,13 +231,39 @@ pub fn overlapping_pairs(
         }
     }
     let start = pairs.len();
-    cells.for_each_candidate_pair(|i, j| {
-        let (a, b) = (i as usize, j as usize);
-        let reach = radii[a] + radii[b];
-        if i != j && space.offset(positions[a], positions[b]).length_squared() < reach * reach {
-            pairs.push((i.min(j), i.max(j)));
+    let mut sorted = std::mem::take(&mut cells.sorted);
+    sorted.clear();
+    sorted.extend(cells.order.iter().map(|&i| (positions[i as usize], radii[i as usize])));
+    let order = &cells.order;
+    let mut test = |k: usize, l: usize| {
+        let ((p, r), (q, s)) = (sorted[k], sorted[l]);
+        let reach = r + s;
+        if space.offset(p, q).length_squared() < reach * reach {
+            let (i, j) = (order[k], order[l]);
+            if i != j {
+                pairs.push((i.min(j), i.max(j)));
+            }
         }
-    });
+    };
+    for y in 0..cells.rows {
+        for x in 0..cells.cols {
+            let here = cells.range(x, y);
+            for k in here.clone() {
+                for l in k + 1..here.end {
+                    test(k, l);
+                }
+            }
+            for (nx, ny) in cells.half_stencil(x, y).into_iter().flatten() {
+                let there = cells.range(nx, ny);
+                for k in here.clone() {
+                    for l in there.clone() {
+                        test(k, l);
+                    }
+                }
+            }
+        }
+    }
+    cells.sorted = sorted;
     if cells.wraps_onto_itself() {
         pairs[start..].sort_unstable();
         let mut seen = start;
