@@ -3,6 +3,11 @@
 //! Events carry the collision counters of the circles they involve; an event whose counters
 //! no longer match was invalidated by an earlier event and is dropped when popped.
 //!
+//! Each circle keeps only its soonest predicted event in the queue (so the queue holds about N
+//! events, not one per neighbour): when an event pops whose owner is unchanged but whose partner
+//! has moved on, nothing can have happened to the owner before it, so the owner is simply
+//! predicted again from that moment.
+//!
 //! Positions are advanced lazily: circle `i` is at `pos[i] + vel[i]·(t - t_at[i])`. A cell list
 //! (cells at least one largest diameter wide, tracked through cell-crossing events) keeps
 //! prediction local. Everything is f64.
@@ -67,6 +72,7 @@ pub struct EventStats {
     pub cell_crossings: u64,
     /// Events popped that had been invalidated.
     pub stale_events: u64,
+
     /// Momentum taken up by the walls, `Σ m |Δv|`.
     pub wall_impulse: f64,
     /// `Σ (r_a + r_b) · j` over collisions.
@@ -157,6 +163,13 @@ pub struct EventEngine {
     prev: Vec<u32>,
     queue: BinaryHeap<Event>,
     stats: EventStats,
+}
+
+impl EventStats {
+    /// Events processed: collisions, wall hits and cell crossings.
+    pub fn events(&self) -> u64 {
+        self.pair_collisions + self.wall_collisions + self.cell_crossings
+    }
 }
 
 impl EventEngine {
@@ -338,12 +351,18 @@ impl EventEngine {
         });
     }
 
-    /// Predicts circle `i`'s next pair collisions (within its neighbourhood), wall hits and
-    /// cell crossings, from `now`.
+    /// Predicts circle `i`'s soonest event from `now` — a pair collision within its
+    /// neighbourhood, a wall hit or a cell crossing — and queues it.
     fn predict(&mut self, i: usize) {
         let now = self.now;
         let p = self.position_at(i, now);
         let v = self.vel[i];
+        let mut soonest: Option<(f64, Kind, u32)> = None;
+        let mut consider = |t: f64, kind: Kind, j: u32| {
+            if soonest.is_none_or(|(best, _, _)| t < best) {
+                soonest = Some((t, kind, j));
+            }
+        };
         let (cells, len) = self.neighbourhood(i);
         for &c in &cells[..len] {
             let mut j = self.head[c];
@@ -353,8 +372,7 @@ impl EventEngine {
                     let dp = self.offset(p, self.position_at(ju, now));
                     let dv = self.vel[ju] - v;
                     if let Some(t) = pair_time_of_impact(dp, dv, self.radius[i] + self.radius[ju]) {
-                        let (a, b) = if i < ju { (i, j) } else { (ju, i as u32) };
-                        self.push(now + t, Kind::Pair, a, b);
+                        consider(t, Kind::Pair, j);
                     }
                 }
                 j = self.next[ju];
@@ -368,7 +386,7 @@ impl EventEngine {
             if let Bounds::Walls { min, max } = self.bounds {
                 let r = self.radius[i];
                 if let Some((t, _)) = wall_time_of_impact(p[a], v[a], min[a] + r, max[a] - r) {
-                    self.push(now + t, Kind::Wall { axis }, i, NONE);
+                    consider(t, Kind::Wall { axis }, NONE);
                 }
             }
             // Cell crossing along this axis (none past the outer cells of a walled box).
@@ -385,7 +403,10 @@ impl EventEngine {
             }
             let edge = self.origin[a] + self.cell[a] * (cell + usize::from(up)) as f64;
             let t = ((edge - p[a]) / v[a]).max(0.0);
-            self.push(now + t, Kind::Cell { axis, up }, i, NONE);
+            consider(t, Kind::Cell { axis, up }, NONE);
+        }
+        if let Some((t, kind, j)) = soonest {
+            self.push(now + t, kind, i, j);
         }
     }
 
@@ -396,9 +417,12 @@ impl EventEngine {
         }
     }
 
-    fn valid(&self, e: &Event) -> bool {
+    fn owner_unchanged(&self, e: &Event) -> bool {
         self.counter[e.i as usize] == e.count_i
-            && (e.j == NONE || self.counter[e.j as usize] == e.count_j)
+    }
+
+    fn partner_unchanged(&self, e: &Event) -> bool {
+        e.j == NONE || self.counter[e.j as usize] == e.count_j
     }
 
     /// Processes every event up to time `t_end` and moves the clock there. Stops early (with the
@@ -410,8 +434,15 @@ impl EventEngine {
                 break;
             }
             self.queue.pop();
-            if !self.valid(&event) {
+            if !self.owner_unchanged(&event) {
                 self.stats.stale_events += 1;
+                continue;
+            }
+            if !self.partner_unchanged(&event) {
+                // The partner moved on; the owner's path is unchanged up to now: predict again.
+                self.stats.stale_events += 1;
+                self.now = event.time.max(self.now);
+                self.predict(event.i as usize);
                 continue;
             }
             if processed == max_events {
@@ -425,8 +456,8 @@ impl EventEngine {
                 Kind::Wall { axis } => self.hit_wall(event.i as usize, axis as usize),
                 Kind::Cell { axis, up } => self.cross_cell(event.i as usize, axis as usize, up),
             }
-            // Stale events pile up in dense systems; start afresh when they dominate.
-            if self.queue.len() > 32 * self.len() + 1024 {
+            // Each circle has one live event; the rest are stale. Start afresh if they pile up.
+            if self.queue.len() > 8 * self.len() + 1024 {
                 self.predict_all();
             }
         }
