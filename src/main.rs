@@ -13,6 +13,16 @@ use moving_circles::run::{Report, headless_app, run_steps, snapshot};
 use moving_circles::scene::{DT_RANGE, particles};
 use moving_circles::schedule::scheduled_systems;
 
+/// Writes a line to stdout. A closed pipe (`moving_circles run … | head -1`) ends the reader's
+/// interest, not our work: the files we were asked for are still written, so write errors on
+/// stdout are ignored instead of panicking as `println!` does.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+
 /// Moving, colliding circles. Without a subcommand, opens the app.
 #[derive(Parser, Debug)]
 #[command(version, about)]
@@ -285,11 +295,16 @@ fn particle_config(
 }
 
 fn print_summary(r: &Report) {
-    println!(
+    say!(
         "{} circles, {}, {} steps of {:.6} s in {:.3} s ({:.4} ms/step)",
-        r.n, r.solver, r.steps, r.dt, r.wall_seconds, r.ms_per_step
+        r.n,
+        r.solver,
+        r.steps,
+        r.dt,
+        r.wall_seconds,
+        r.ms_per_step
     );
-    println!(
+    say!(
         "energy drift {:+.3e}, max penetration {:.3e}, collisions {} pair / {} wall, escaped {}, non-finite {}",
         r.energy_drift,
         r.max_penetration,
@@ -324,7 +339,7 @@ fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
         }
     }
     bar.finish_and_clear();
-    print!("{}", to_table(&rows));
+    say!("{}", to_table(&rows).trim_end());
     let csv = out.join("accuracy.csv");
     particles::write_atomically(&csv, &to_csv(&rows))
         .with_context(|| format!("writing {}", csv.display()))?;
@@ -332,7 +347,7 @@ fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     let partial = out.join(".accuracy.svg.partial");
     plot(&rows, &partial).map_err(|e| anyhow::anyhow!("drawing {}: {e}", svg.display()))?;
     std::fs::rename(&partial, &svg).with_context(|| format!("writing {}", svg.display()))?;
-    println!("wrote {} and {}", csv.display(), svg.display());
+    say!("wrote {} and {}", csv.display(), svg.display());
     Ok(())
 }
 
@@ -350,7 +365,7 @@ fn systems(scene: &Path) -> anyhow::Result<()> {
             continue;
         }
         let name = system.rsplit("::").next().unwrap_or(&system);
-        println!("{schedule} {name}");
+        say!("{schedule} {name}");
     }
     Ok(())
 }

@@ -172,3 +172,34 @@ fn systems_lists_what_each_scene_schedules() {
     assert!(gas.lines().any(|l| l == "CircleStep wrap_around"), "{gas}");
     assert!(!gas.contains("bounce_off_walls"), "{gas}");
 }
+
+#[test]
+fn a_closed_stdout_is_not_a_crash() {
+    // `moving_circles run … | head -1`: the reader goes away before the summary is printed.
+    let dir = temp_dir("pipe");
+    let report = dir.join("r.json");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args([
+            "run",
+            "--scene",
+            "assets/scenes/classic.ron",
+            "--steps",
+            "200",
+            "--report",
+            report.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(report.exists(), "the report is still written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -233,7 +233,12 @@ pub fn overlapping_pairs(
     let start = pairs.len();
     let mut sorted = std::mem::take(&mut cells.sorted);
     sorted.clear();
-    sorted.extend(cells.order.iter().map(|&i| (positions[i as usize], radii[i as usize])));
+    sorted.extend(
+        cells
+            .order
+            .iter()
+            .map(|&i| (positions[i as usize], radii[i as usize])),
+    );
     // Per circle (in cell order): the rest of its own cell, then the half stencil's cells.
     // Empty cells cost nothing this way, and there are more cells than circles in a sparse gas.
     for y in 0..cells.rows {
