@@ -10,6 +10,7 @@
 use std::time::Duration;
 
 use bevy::ecs::schedule::ScheduleLabel;
+use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 
 use crate::config::{Arena, Effects, Solver};
@@ -89,6 +90,14 @@ impl Plugin for StepPlugin {
             .init_resource::<CollisionCounters>()
             .init_schedule(CircleStep)
             .init_schedule(ContinuousStep)
+            // The step's systems run in a chain, so a multi-threaded executor would only add
+            // thread wake-ups to every substep.
+            .edit_schedule(CircleStep, |s| {
+                s.set_executor(SingleThreadedExecutor::new());
+            })
+            .edit_schedule(ContinuousStep, |s| {
+                s.set_executor(SingleThreadedExecutor::new());
+            })
             .configure_sets(
                 ContinuousStep,
                 (CircleSystems::Forces, CircleSystems::Continuous).chain(),

@@ -6,6 +6,7 @@
 //! four of its eight neighbours (the "half stencil").
 
 use bevy::math::DVec2;
+use bevy::tasks::{ComputeTaskPool, TaskPool};
 
 /// Circles bucketed by cell: `order[start[c]..start[c + 1]]` are the circles in cell `c`.
 #[derive(Debug, Default, Clone)]
@@ -211,8 +212,51 @@ impl Space {
     }
 }
 
+/// Circle count from which the pair scan runs on all cores.
+pub const PARALLEL_FROM: usize = 4_000;
+
+/// Scans the cells of `rows`, appending overlapping pairs: per circle (in cell order), the rest
+/// of its own cell, then the half stencil's cells. Visiting circles rather than cells skips the
+/// empty cells, which outnumber circles in a sparse gas.
+fn scan_rows(
+    cells: &CellList,
+    sorted: &[(DVec2, f64)],
+    space: Space,
+    rows: std::ops::Range<usize>,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    for y in rows {
+        for x in 0..cells.cols {
+            let here = cells.range(x, y);
+            if here.is_empty() {
+                continue;
+            }
+            let mut stencil = [0..0, 0..0, 0..0, 0..0];
+            for (slot, cell) in stencil.iter_mut().zip(cells.half_stencil(x, y)) {
+                if let Some((nx, ny)) = cell {
+                    *slot = cells.range(nx, ny);
+                }
+            }
+            for k in here.clone() {
+                let (p, r) = sorted[k];
+                for l in (k + 1..here.end).chain(stencil.iter().flat_map(Clone::clone)) {
+                    let (q, s) = sorted[l];
+                    let reach = r + s;
+                    if space.offset(p, q).length_squared() < reach * reach {
+                        let (i, j) = (cells.order[k], cells.order[l]);
+                        if i != j {
+                            pairs.push((i.min(j), i.max(j)));
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Appends to `pairs` every pair `(i, j)`, `i < j`, of circles that overlap (centre distance
-/// below the sum of radii), found through `cells`. The order depends only on the input.
+/// below the sum of radii), found through `cells`. The order depends only on the input, not on
+/// the number of threads.
 ///
 /// The scan runs over copies of the positions and radii laid out in cell order, so the inner
 /// loops read contiguous memory instead of jumping through the circles in entity order.
@@ -239,34 +283,29 @@ pub fn overlapping_pairs(
             .iter()
             .map(|&i| (positions[i as usize], radii[i as usize])),
     );
-    // Per circle (in cell order): the rest of its own cell, then the half stencil's cells.
-    // Empty cells cost nothing this way, and there are more cells than circles in a sparse gas.
-    for y in 0..cells.rows {
-        for x in 0..cells.cols {
-            let here = cells.range(x, y);
-            if here.is_empty() {
-                continue;
+    if positions.len() >= PARALLEL_FROM {
+        // Rows are independent: scan bands of rows on the task pool and append each band's
+        // pairs in row order, so the result does not depend on the number of threads.
+        let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+        let bands = (pool.thread_num() * 4).clamp(1, cells.rows);
+        let per_band = cells.rows.div_ceil(bands);
+        let cells = &*cells;
+        let sorted = &sorted;
+        let found = pool.scope(|scope| {
+            for band in 0..bands {
+                let rows = band * per_band..((band + 1) * per_band).min(cells.rows);
+                scope.spawn(async move {
+                    let mut out = Vec::new();
+                    scan_rows(cells, sorted, space, rows, &mut out);
+                    out
+                });
             }
-            let mut stencil = [0..0, 0..0, 0..0, 0..0];
-            for (slot, cell) in stencil.iter_mut().zip(cells.half_stencil(x, y)) {
-                if let Some((nx, ny)) = cell {
-                    *slot = cells.range(nx, ny);
-                }
-            }
-            for k in here.clone() {
-                let (p, r) = sorted[k];
-                for l in (k + 1..here.end).chain(stencil.iter().flat_map(Clone::clone)) {
-                    let (q, s) = sorted[l];
-                    let reach = r + s;
-                    if space.offset(p, q).length_squared() < reach * reach {
-                        let (i, j) = (cells.order[k], cells.order[l]);
-                        if i != j {
-                            pairs.push((i.min(j), i.max(j)));
-                        }
-                    }
-                }
-            }
+        });
+        for band in found {
+            pairs.extend(band);
         }
+    } else {
+        scan_rows(cells, &sorted, space, 0..cells.rows, pairs);
     }
     cells.sorted = sorted;
     if cells.wraps_onto_itself() {
