@@ -3,7 +3,8 @@
 //! effects: a no-collision scene against the same scene with collisions and against bare
 //! integration.
 //!
-//! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver.
+//! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver and
+//! N = 1M for `discrete`.
 
 use bevy::math::DVec2;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};

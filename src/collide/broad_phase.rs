@@ -407,6 +407,32 @@ mod tests {
     }
 
     #[test]
+    fn the_parallel_scan_gives_the_sequential_result_in_the_same_order() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let n = 3 * PARALLEL_FROM;
+        let positions: Vec<DVec2> = (0..n)
+            .map(|_| DVec2::new(rng.random_range(0.0..60.0), rng.random_range(0.0..40.0)))
+            .collect();
+        let radii: Vec<f64> = (0..n).map(|_| rng.random_range(0.05..0.3)).collect();
+        for space in [
+            Space::Open,
+            Space::Periodic {
+                min: DVec2::ZERO,
+                size: DVec2::new(60.0, 40.0),
+            },
+        ] {
+            let mut cells = CellList::default();
+            let mut parallel = Vec::new();
+            overlapping_pairs(&mut cells, space, &positions, &radii, &mut parallel);
+            // One band over all rows: what a single thread does.
+            let mut sequential = Vec::new();
+            scan_rows(&cells, &cells.sorted, space, 0..cells.rows, &mut sequential);
+            assert!(parallel.len() > 1000, "{}", parallel.len());
+            assert_eq!(parallel, sequential);
+        }
+    }
+
+    #[test]
     fn non_finite_positions_take_part_in_no_pair() {
         let positions = [DVec2::ZERO, DVec2::new(f64::NAN, 0.0), DVec2::new(0.1, 0.0)];
         let mut pairs = Vec::new();
