@@ -44,20 +44,22 @@ fn bench_config(c: &mut Criterion, group: &str, id: BenchmarkId, n: usize, confi
 }
 
 fn solvers(c: &mut Criterion) {
+    let large = std::env::var_os("MC_BENCH_LARGE").is_some();
     let mut sizes = vec![1_000, 10_000];
-    if std::env::var_os("MC_BENCH_LARGE").is_some() {
+    if large {
         sizes.push(100_000);
     }
+    let solvers = [Solver::Discrete, Solver::Substeps(4), Solver::Swept, Solver::Exact];
     for n in sizes {
-        for solver in [
-            Solver::Discrete,
-            Solver::Substeps(4),
-            Solver::Swept,
-            Solver::Exact,
-        ] {
+        for solver in solvers {
             let id = BenchmarkId::new(solver.to_string(), n);
             bench_config(c, "step_gas", id, n, gas_config(n, solver));
         }
+    }
+    if large {
+        let n = 1_000_000;
+        let id = BenchmarkId::new(Solver::Discrete.to_string(), n);
+        bench_config(c, "step_gas", id, n, gas_config(n, Solver::Discrete));
     }
 }
 
