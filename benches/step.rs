@@ -49,7 +49,12 @@ fn solvers(c: &mut Criterion) {
     if large {
         sizes.push(100_000);
     }
-    let solvers = [Solver::Discrete, Solver::Substeps(4), Solver::Swept, Solver::Exact];
+    let solvers = [
+        Solver::Discrete,
+        Solver::Substeps(4),
+        Solver::Swept,
+        Solver::Exact,
+    ];
     for n in sizes {
         for solver in solvers {
             let id = BenchmarkId::new(solver.to_string(), n);

@@ -5,9 +5,11 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::collide::broad_phase::{CellList, Space, overlapping_pairs};
 use crate::components::{Mass, Position, Radius, Velocity};
 use crate::config::{Arena, Effects};
 use crate::schedule::CircleSystems;
+use crate::spawn::CircleInit;
 use crate::spawn::SpawnReport;
 
 /// Running totals since the last (re)spawn, written by the step systems.
@@ -46,27 +48,36 @@ pub struct Overlaps {
     pub sum: f64,
 }
 
-impl Overlaps {
-    /// Measures the overlaps of circles at `positions` with `radii` (broad phase, so O(N)).
-    pub fn measure(
-        positions: &[DVec2],
-        radii: &[f64],
-        space: crate::collide::broad_phase::Space,
-    ) -> Self {
-        use crate::collide::broad_phase::{CellList, overlapping_pairs};
-        let mut pairs = Vec::new();
-        overlapping_pairs(
-            &mut CellList::default(),
-            space,
-            positions,
-            radii,
-            &mut pairs,
-        );
-        let mut overlaps = Self::default();
-        for (i, j) in pairs {
+/// Every overlapping pair `(i, j, depth)` of `circles` (`i < j`, sorted), with `depth` the
+/// overlap distance `r_i + r_j − |x_j − x_i|` in `space` (broad phase, so O(N)).
+pub fn overlapping_circles(circles: &[CircleInit], space: Space) -> Vec<(usize, usize, f64)> {
+    let positions: Vec<DVec2> = circles.iter().map(|c| c.position).collect();
+    let radii: Vec<f64> = circles.iter().map(|c| c.radius).collect();
+    let mut pairs = Vec::new();
+    overlapping_pairs(
+        &mut CellList::default(),
+        space,
+        &positions,
+        &radii,
+        &mut pairs,
+    );
+    pairs.sort_unstable();
+    pairs
+        .into_iter()
+        .map(|(i, j)| {
             let (i, j) = (i as usize, j as usize);
             let depth = radii[i] + radii[j] - space.offset(positions[i], positions[j]).length();
-            let fraction = depth / radii[i].min(radii[j]);
+            (i, j, depth)
+        })
+        .collect()
+}
+
+impl Overlaps {
+    /// Measures the overlaps of `circles` in `space`.
+    pub fn measure(circles: &[CircleInit], space: Space) -> Self {
+        let mut overlaps = Self::default();
+        for (i, j, depth) in overlapping_circles(circles, space) {
+            let fraction = depth / circles[i].radius.min(circles[j].radius);
             overlaps.pairs += 1;
             overlaps.max = overlaps.max.max(fraction);
             overlaps.sum += fraction;

@@ -124,10 +124,7 @@ pub struct Report {
 pub fn overlaps(world: &mut World) -> Overlaps {
     let arena = *world.resource::<Arena>();
     let boundary = world.resource::<Effects>().boundary;
-    let circles = snapshot(world);
-    let positions: Vec<_> = circles.iter().map(|c| c.position).collect();
-    let radii: Vec<_> = circles.iter().map(|c| c.radius).collect();
-    Overlaps::measure(&positions, &radii, collision_space(&arena, boundary))
+    Overlaps::measure(&snapshot(world), collision_space(&arena, boundary))
 }
 
 /// Steps `app` `steps` times, calling `progress(done)` now and then, and reports. Overlaps are

@@ -21,8 +21,8 @@ use std::path::Path;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
-use moving_circles::collide::broad_phase::{CellList, overlapping_pairs};
 use moving_circles::collide::collision_space;
+use moving_circles::diagnostics::overlapping_circles;
 use moving_circles::prelude::*;
 use moving_circles::scene::particles;
 use moving_circles::spawn::CircleInit;
@@ -88,21 +88,10 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
     for _ in 0..steps {
         step(&mut app, 1);
         let now = state(&mut app);
-        let positions: Vec<DVec2> = now.iter().map(|c| c.position).collect();
-        let radii: Vec<f64> = now.iter().map(|c| c.radius).collect();
-        let mut pairs = Vec::new();
-        overlapping_pairs(
-            &mut CellList::default(),
-            space,
-            &positions,
-            &radii,
-            &mut pairs,
-        );
         let mut still = HashMap::new();
-        for (i, j) in pairs {
-            let (a, b) = (&now[i as usize], &now[j as usize]);
-            let depth = (a.radius + b.radius - space.offset(a.position, b.position).length())
-                / a.radius.min(b.radius);
+        for (i, j, depth) in overlapping_circles(&now, space) {
+            let (i, j) = (i as u32, j as u32);
+            let depth = depth / now[i as usize].radius.min(now[j as usize].radius);
             outcome.max_overlap = outcome.max_overlap.max(depth);
             // Touching to rounding (exactly touching circles) is contact, not an overlap to fix.
             if depth <= ROUNDING {

@@ -435,25 +435,13 @@ pub fn first_overlap(
     boundary: Boundary,
     arena: &Arena,
 ) -> Option<(usize, usize, f64)> {
-    use crate::collide::broad_phase::{CellList, overlapping_pairs};
-    let positions: Vec<DVec2> = circles.iter().map(|c| c.position).collect();
-    let radii: Vec<f64> = circles.iter().map(|c| c.radius).collect();
     let space = crate::collide::collision_space(arena, boundary);
-    let mut pairs = Vec::new();
-    overlapping_pairs(
-        &mut CellList::default(),
-        space,
-        &positions,
-        &radii,
-        &mut pairs,
-    );
-    pairs.sort_unstable();
-    pairs.into_iter().find_map(|(i, j)| {
-        let (a, b) = (&circles[i as usize], &circles[j as usize]);
-        let depth = a.radius + b.radius - space.offset(a.position, b.position).length();
-        let slack = rounding_slack(a.position, a.radius).max(rounding_slack(b.position, b.radius));
-        (depth > slack).then_some((i as usize, j as usize, depth))
-    })
+    crate::diagnostics::overlapping_circles(circles, space)
+        .into_iter()
+        .find(|&(i, j, depth)| {
+            let (a, b) = (&circles[i], &circles[j]);
+            depth > rounding_slack(a.position, a.radius).max(rounding_slack(b.position, b.radius))
+        })
 }
 
 /// Pushes overlapping circles apart (positions only, split by inverse mass, kept inside the

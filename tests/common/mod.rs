@@ -6,19 +6,12 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use bevy::time::TimeUpdateStrategy;
 use moving_circles::prelude::*;
 
 /// A headless app running `config`, already past `Startup` (circles spawned), in which every
-/// `update()` advances exactly one fixed step.
+/// `update()` advances exactly one fixed step: the same app `moving_circles run` steps.
 pub fn create_app(config: CirclesConfig) -> App {
-    let mut app = App::new();
-    app.add_plugins((MinimalPlugins, CirclesPlugins::new(config)))
-        .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
-    app.finish();
-    app.cleanup();
-    app.update();
-    app
+    moving_circles::run::headless_app(config)
 }
 
 /// A config with no random circles, so a test can place its own.
