@@ -1,10 +1,16 @@
-//! The heads-up display: circle count, solver, steps per second, kinetic-energy drift since the
-//! last reset and collisions per second, refreshed a few times a second; `h` toggles the help.
+//! The heads-up display, refreshed twice a second: circle count, solver, steps per second,
+//! energy drift since the last reset and collisions per second; then pressure (virial and
+//! walls), momentum, overlaps, escapes and non-finite values. `h` toggles the help.
 
 use bevy::prelude::*;
 
-use crate::config::Solver;
-use crate::diagnostics::{CircleDiagnostics, CollisionCounters};
+use bevy::math::DVec2;
+
+use crate::collide::collision_space;
+use crate::components::{Position, Radius};
+use crate::config::{Arena, Boundary, Effects, Solver};
+use crate::diagnostics::{CircleDiagnostics, CollisionCounters, Overlaps, Pressure};
+use crate::spawn::CircleInit;
 
 /// The HUD text and the help overlay.
 #[derive(Clone, Copy, Debug, Default)]
@@ -85,12 +91,40 @@ struct RateWindow {
 
 const REFRESH_SECONDS: f64 = 0.5;
 
+/// The HUD's second line: pressure both ways, overlaps, escapes and non-finite values.
+fn physics_line(
+    diagnostics: &CircleDiagnostics,
+    counters: &CollisionCounters,
+    arena: &Arena,
+    effects: &Effects,
+    overlaps: &Overlaps,
+) -> String {
+    let walls = effects.boundary == Boundary::Walls;
+    let p = Pressure::measure(counters, diagnostics.count, diagnostics.kinetic_energy, arena, walls);
+    let z = |z: Option<f64>| z.map_or("-".to_owned(), |z| format!("{z:.3}"));
+    format!(
+        "pressure z {} (walls {})   momentum ({:+.3e}, {:+.3e})   overlap max {:.3} mean {:.3} r   escaped {}   non-finite {}",
+        z(p.z_virial),
+        z(p.z_wall),
+        diagnostics.momentum.x,
+        diagnostics.momentum.y,
+        overlaps.max,
+        if overlaps.pairs == 0 { 0.0 } else { overlaps.sum / overlaps.pairs as f64 },
+        diagnostics.escaped,
+        diagnostics.non_finite,
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
 fn update_hud(
     real: Res<Time<Real>>,
     virt: Res<Time<Virtual>>,
     solver: Res<Solver>,
+    arena: Res<Arena>,
+    effects: Res<Effects>,
     diagnostics: Res<CircleDiagnostics>,
     counters: Res<CollisionCounters>,
+    circles: Query<(&Position, &Radius)>,
     mut window: Local<RateWindow>,
     mut text: Single<&mut Text, With<HudText>>,
 ) {
@@ -113,14 +147,27 @@ fn update_hud(
     } else {
         String::new()
     };
+    // Overlaps are measured here, at the HUD's refresh rate, not every step.
+    let snapshot: Vec<CircleInit> = circles
+        .iter()
+        .map(|(p, r)| CircleInit {
+            position: p.0,
+            velocity: DVec2::ZERO,
+            radius: r.0,
+            mass: 1.0,
+            tint: [0; 3],
+        })
+        .collect();
+    let overlaps = Overlaps::measure(&snapshot, collision_space(&arena, effects.boundary));
     text.0 = format!(
-        "circles {}   solver {}   {:.0} steps/s   energy drift {:+.2e}   {:.0} collisions/s{}   (h: help)",
+        "circles {}   solver {}   {:.0} steps/s   energy drift {:+.2e}   {:.0} collisions/s{}   (h: help)\n{}",
         diagnostics.count,
         *solver,
         window.steps_per_second,
         diagnostics.energy_drift(),
         window.collisions_per_second,
         state,
+        physics_line(&diagnostics, &counters, &arena, &effects, &overlaps),
     );
 }
 
