@@ -136,6 +136,41 @@ impl CellList {
         &self.order[self.range(x, y)]
     }
 
+    /// Calls `visit(k)` for every circle (as its position `k` in the cell order) in the cells
+    /// that the box `[lo, hi]` touches; on a periodic grid the box wraps around.
+    pub fn for_each_in_box(&self, lo: DVec2, hi: DVec2, mut visit: impl FnMut(usize)) {
+        let to_cell = |p: DVec2| {
+            let mut c = (p - self.origin) * self.inv_cell;
+            if self.periodic {
+                c.y *= self.y_scale;
+            }
+            c.floor()
+        };
+        let (a, b) = (to_cell(lo), to_cell(hi));
+        let axis = |from: f64, to: f64, count: usize| -> Vec<usize> {
+            if !(from.is_finite() && to.is_finite()) {
+                return Vec::new();
+            }
+            if self.periodic {
+                if to - from + 1.0 >= count as f64 {
+                    return (0..count).collect();
+                }
+                (from as i64..=to as i64)
+                    .map(|c| c.rem_euclid(count as i64) as usize)
+                    .collect()
+            } else {
+                let clamp = |c: f64| (c.max(0.0) as usize).min(count - 1);
+                (clamp(from)..=clamp(to)).collect()
+            }
+        };
+        let xs = axis(a.x, b.x, self.cols);
+        for y in axis(a.y, b.y, self.rows) {
+            for &x in &xs {
+                self.range(x, y).for_each(&mut visit);
+            }
+        }
+    }
+
     /// Positions in [`Self::order`] of the circles in cell `(x, y)`.
     fn range(&self, x: usize, y: usize) -> std::ops::Range<usize> {
         let c = y * self.cols + x;
@@ -254,13 +289,110 @@ fn scan_rows(
     }
 }
 
+/// Radius ratio (largest / smallest) above which [`overlapping_pairs`] sorts circles into
+/// levels of similar size, each with its own grid: one grid sized for the largest circle would
+/// put thousands of small circles in each cell.
+pub const MULTI_LEVEL_RATIO: f64 = 8.0;
+
 /// Appends to `pairs` every pair `(i, j)`, `i < j`, of circles that overlap (centre distance
-/// below the sum of radii), found through `cells`. The order depends only on the input, not on
-/// the number of threads.
+/// below the sum of radii). The order depends only on the input, not on the number of threads.
+///
+/// Circles of similar size share one uniform grid (`cells`); when radii span more than
+/// [`MULTI_LEVEL_RATIO`], circles are split into levels by size (a factor of 4 per level), each
+/// level gets its own grid, and each circle also checks the cells of the finer levels under it.
+pub fn overlapping_pairs(
+    cells: &mut CellList,
+    space: Space,
+    positions: &[DVec2],
+    radii: &[f64],
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    let (r_min, r_max) = radii.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| {
+        (lo.min(r), hi.max(r))
+    });
+    if r_max <= MULTI_LEVEL_RATIO * r_min || !(r_min > 0.0) {
+        single_level_pairs(cells, space, positions, radii, pairs);
+    } else {
+        multi_level_pairs(space, positions, radii, r_min, pairs);
+    }
+}
+
+fn multi_level_pairs(
+    space: Space,
+    positions: &[DVec2],
+    radii: &[f64],
+    r_min: f64,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    let level_of = |r: f64| ((r / r_min).log2() / 2.0).floor().max(0.0) as usize;
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    for (i, &r) in radii.iter().enumerate() {
+        let l = level_of(r);
+        if members.len() <= l {
+            members.resize(l + 1, Vec::new());
+        }
+        members[l].push(i as u32);
+    }
+    struct Level {
+        members: Vec<u32>,
+        cells: CellList,
+        max_radius: f64,
+    }
+    let mut levels: Vec<Level> = Vec::with_capacity(members.len());
+    let start = pairs.len();
+    for members in members {
+        let pos: Vec<DVec2> = members.iter().map(|&i| positions[i as usize]).collect();
+        let rad: Vec<f64> = members.iter().map(|&i| radii[i as usize]).collect();
+        let mut cells = CellList::default();
+        let mut local = Vec::new();
+        single_level_pairs(&mut cells, space, &pos, &rad, &mut local);
+        pairs.extend(local.into_iter().map(|(a, b)| {
+            let (i, j) = (members[a as usize], members[b as usize]);
+            (i.min(j), i.max(j))
+        }));
+        let max_radius = rad.iter().copied().fold(0.0f64, f64::max);
+        levels.push(Level {
+            members,
+            cells,
+            max_radius,
+        });
+    }
+    // Each circle against the finer levels: the cells its reach could touch.
+    for (m, coarse) in levels.iter().enumerate() {
+        for &a in &coarse.members {
+            let (p, r) = (positions[a as usize], radii[a as usize]);
+            for fine in &levels[..m] {
+                if fine.members.is_empty() {
+                    continue;
+                }
+                let reach = DVec2::splat(r + fine.max_radius);
+                fine.cells.for_each_in_box(p - reach, p + reach, |k| {
+                    let b = fine.members[fine.cells.order[k] as usize];
+                    let sigma = r + radii[b as usize];
+                    if space.offset(p, positions[b as usize]).length_squared() < sigma * sigma {
+                        pairs.push((a.min(b), a.max(b)));
+                    }
+                });
+            }
+        }
+    }
+    // A box wider than a periodic grid visits some cells twice; keep each pair once.
+    pairs[start..].sort_unstable();
+    let mut kept = start;
+    for k in start..pairs.len() {
+        if k == start || pairs[k] != pairs[kept - 1] {
+            pairs[kept] = pairs[k];
+            kept += 1;
+        }
+    }
+    pairs.truncate(kept);
+}
+
+/// [`overlapping_pairs`] on one uniform grid with cells one largest diameter wide.
 ///
 /// The scan runs over copies of the positions and radii laid out in cell order, so the inner
 /// loops read contiguous memory instead of jumping through the circles in entity order.
-pub fn overlapping_pairs(
+fn single_level_pairs(
     cells: &mut CellList,
     space: Space,
     positions: &[DVec2],
@@ -429,6 +561,42 @@ mod tests {
             scan_rows(&cells, &cells.sorted, space, 0..cells.rows, &mut sequential);
             assert!(parallel.len() > 1000, "{}", parallel.len());
             assert_eq!(parallel, sequential);
+        }
+    }
+
+    #[test]
+    fn radii_spanning_decades_find_exactly_the_brute_force_pairs() {
+        let mut rng = ChaCha8Rng::seed_from_u64(10);
+        for periodic in [false, true] {
+            let size = DVec2::new(1.0, 0.8);
+            let space = if periodic {
+                Space::Periodic {
+                    min: DVec2::ZERO,
+                    size,
+                }
+            } else {
+                Space::Open
+            };
+            let n = 1500;
+            let positions: Vec<DVec2> = (0..n)
+                .map(|_| DVec2::new(rng.random_range(0.0..size.x), rng.random_range(0.0..size.y)))
+                .collect();
+            // Radii log-uniform over 1e-4 .. 1e-1: four decades, several levels.
+            let radii: Vec<f64> = (0..n)
+                .map(|_| 10f64.powf(rng.random_range(-4.0..-1.0)))
+                .collect();
+            let mut pairs = Vec::new();
+            overlapping_pairs(
+                &mut CellList::default(),
+                space,
+                &positions,
+                &radii,
+                &mut pairs,
+            );
+            pairs.sort_unstable();
+            let expected = brute_force(space, &positions, &radii);
+            assert!(expected.len() > 50, "{}", expected.len());
+            assert_eq!(pairs, expected, "periodic = {periodic}");
         }
     }
 

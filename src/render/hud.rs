@@ -100,7 +100,13 @@ fn physics_line(
     overlaps: &Overlaps,
 ) -> String {
     let walls = effects.boundary == Boundary::Walls;
-    let p = Pressure::measure(counters, diagnostics.count, diagnostics.kinetic_energy, arena, walls);
+    let p = Pressure::measure(
+        counters,
+        diagnostics.count,
+        diagnostics.kinetic_energy,
+        arena,
+        walls,
+    );
     let z = |z: Option<f64>| z.map_or("-".to_owned(), |z| format!("{z:.3}"));
     format!(
         "pressure z {} (walls {})   momentum ({:+.3e}, {:+.3e})   overlap max {:.3} mean {:.3} r   escaped {}   non-finite {}",
@@ -109,7 +115,11 @@ fn physics_line(
         diagnostics.momentum.x,
         diagnostics.momentum.y,
         overlaps.max,
-        if overlaps.pairs == 0 { 0.0 } else { overlaps.sum / overlaps.pairs as f64 },
+        if overlaps.pairs == 0 {
+            0.0
+        } else {
+            overlaps.sum / overlaps.pairs as f64
+        },
         diagnostics.escaped,
         diagnostics.non_finite,
     )
