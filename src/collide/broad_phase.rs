@@ -310,7 +310,7 @@ pub fn overlapping_pairs(
     let (r_min, r_max) = radii.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| {
         (lo.min(r), hi.max(r))
     });
-    if r_max <= MULTI_LEVEL_RATIO * r_min || !(r_min > 0.0) {
+    if r_min <= 0.0 || r_min.is_nan() || r_max <= MULTI_LEVEL_RATIO * r_min {
         single_level_pairs(cells, space, positions, radii, pairs);
     } else {
         multi_level_pairs(space, positions, radii, r_min, pairs);
