@@ -377,15 +377,15 @@ fn multi_level_pairs(
         }
     }
     // A box wider than a periodic grid visits some cells twice; keep each pair once.
-    pairs[start..].sort_unstable();
-    let mut kept = start;
-    for k in start..pairs.len() {
-        if k == start || pairs[k] != pairs[kept - 1] {
-            pairs[kept] = pairs[k];
-            kept += 1;
-        }
-    }
-    pairs.truncate(kept);
+    sort_and_dedupe(pairs, start);
+}
+
+/// Sorts `pairs[start..]` and drops repeats.
+fn sort_and_dedupe(pairs: &mut Vec<(u32, u32)>, start: usize) {
+    let mut found = pairs.split_off(start);
+    found.sort_unstable();
+    found.dedup();
+    pairs.append(&mut found);
 }
 
 /// [`overlapping_pairs`] on one uniform grid with cells one largest diameter wide.
@@ -441,15 +441,7 @@ fn single_level_pairs(
     }
     cells.sorted = sorted;
     if cells.wraps_onto_itself() {
-        pairs[start..].sort_unstable();
-        let mut seen = start;
-        for k in start..pairs.len() {
-            if k == start || pairs[k] != pairs[seen - 1] {
-                pairs[seen] = pairs[k];
-                seen += 1;
-            }
-        }
-        pairs.truncate(seen);
+        sort_and_dedupe(pairs, start);
     }
 }
 
@@ -458,6 +450,26 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// The broad phase's pairs, sorted, checked against brute force.
+    fn pairs_checked(space: Space, positions: &[DVec2], radii: &[f64]) -> Vec<(u32, u32)> {
+        let mut pairs = Vec::new();
+        overlapping_pairs(
+            &mut CellList::default(),
+            space,
+            positions,
+            radii,
+            &mut pairs,
+        );
+        pairs.sort_unstable();
+        assert_eq!(
+            pairs,
+            brute_force(space, positions, radii),
+            "{space:?}, n = {}",
+            positions.len()
+        );
+        pairs
+    }
 
     fn brute_force(space: Space, positions: &[DVec2], radii: &[f64]) -> Vec<(u32, u32)> {
         let mut pairs = Vec::new();
@@ -480,17 +492,7 @@ mod tests {
                 .map(|_| DVec2::new(rng.random_range(0.0..spread), rng.random_range(0.0..spread)))
                 .collect();
             let radii: Vec<f64> = (0..n).map(|_| rng.random_range(0.01..0.3)).collect();
-            let mut pairs = Vec::new();
-            overlapping_pairs(
-                &mut CellList::default(),
-                Space::Open,
-                &positions,
-                &radii,
-                &mut pairs,
-            );
-            pairs.sort_unstable();
-            let expected = brute_force(Space::Open, &positions, &radii);
-            assert_eq!(pairs, expected, "n = {n}, spread = {spread}");
+            pairs_checked(Space::Open, &positions, &radii);
         }
     }
 
@@ -514,23 +516,13 @@ mod tests {
                 })
                 .collect();
             let radii: Vec<f64> = (0..n).map(|_| rng.random_range(0.01..r_max)).collect();
-            let mut pairs = Vec::new();
-            overlapping_pairs(
-                &mut CellList::default(),
-                space,
-                &positions,
-                &radii,
-                &mut pairs,
-            );
-            pairs.sort_unstable();
-            let expected = brute_force(space, &positions, &radii);
+            let expected = pairs_checked(space, &positions, &radii);
             seam_pairs += expected
                 .iter()
                 .filter(|&&(i, j)| {
                     (positions[i as usize] - positions[j as usize]).length() > size.x / 2.0
                 })
                 .count();
-            assert_eq!(pairs, expected, "n = {n}, side = {side}");
         }
         assert!(
             seam_pairs > 0,
@@ -585,18 +577,8 @@ mod tests {
             let radii: Vec<f64> = (0..n)
                 .map(|_| 10f64.powf(rng.random_range(-4.0..-1.0)))
                 .collect();
-            let mut pairs = Vec::new();
-            overlapping_pairs(
-                &mut CellList::default(),
-                space,
-                &positions,
-                &radii,
-                &mut pairs,
-            );
-            pairs.sort_unstable();
-            let expected = brute_force(space, &positions, &radii);
+            let expected = pairs_checked(space, &positions, &radii);
             assert!(expected.len() > 50, "{}", expected.len());
-            assert_eq!(pairs, expected, "periodic = {periodic}");
         }
     }
 
