@@ -132,10 +132,6 @@ impl CellList {
         (y * self.cols + x) as u32
     }
 
-    fn cell(&self, x: usize, y: usize) -> &[u32] {
-        &self.order[self.range(x, y)]
-    }
-
     /// Calls `visit(k)` for every circle (as its position `k` in the cell order) in the cells
     /// that the box `[lo, hi]` touches; on a periodic grid the box wraps around.
     pub fn for_each_in_box(&self, lo: DVec2, hi: DVec2, mut visit: impl FnMut(usize)) {
@@ -194,31 +190,6 @@ impl CellList {
             (y + 1 < rows).then(|| (x, y + 1)),
             (y + 1 < rows && x + 1 < cols).then(|| (x + 1, y + 1)),
         ]
-    }
-
-    /// Calls `visit(i, j)` once for every pair of circles in the same or adjacent cells
-    /// (on a periodic grid that [`wraps_onto_itself`](Self::wraps_onto_itself), pairs can repeat
-    /// and a circle can meet itself: callers dedupe).
-    pub fn for_each_candidate_pair(&self, mut visit: impl FnMut(u32, u32)) {
-        for y in 0..self.rows {
-            for x in 0..self.cols {
-                let here = self.cell(x, y);
-                for (k, &i) in here.iter().enumerate() {
-                    for &j in &here[k + 1..] {
-                        visit(i, j);
-                    }
-                }
-                // Right, and the three cells of the row above: each neighbour pair once.
-                for (nx, ny) in self.half_stencil(x, y).into_iter().flatten() {
-                    let there = self.cell(nx, ny);
-                    for &i in here {
-                        for &j in there {
-                            visit(i, j);
-                        }
-                    }
-                }
-            }
-        }
     }
 }
 
