@@ -165,13 +165,6 @@ pub struct EventEngine {
     stats: EventStats,
 }
 
-impl EventStats {
-    /// Events processed: collisions, wall hits and cell crossings.
-    pub fn events(&self) -> u64 {
-        self.pair_collisions + self.wall_collisions + self.cell_crossings
-    }
-}
-
 impl EventEngine {
     /// Builds the engine at time 0 and predicts every circle's first events. Circles must have
     /// finite state; with walls their centres must lie within `[min + r, max - r]` (a centre
