@@ -254,7 +254,9 @@ impl FromStr for Boundary {
 #[reflect(Resource, Debug)]
 #[serde(default, deny_unknown_fields)]
 pub struct Effects {
-    /// Walls or periodic edges.
+    /// Walls or periodic edges. Not read from a scene's `effects` (a scene sets it as
+    /// `arena.boundary`), so writing it there is an unknown-field error, not silently ignored.
+    #[serde(skip)]
     pub boundary: Boundary,
     /// Circle-circle collisions (broad phase, separation and impulse).
     pub collisions: bool,

@@ -35,6 +35,12 @@ fn an_unknown_field_is_named() {
 }
 
 #[test]
+fn the_boundary_belongs_to_the_arena_not_the_effects() {
+    let e = scene_error("(effects: (boundary: periodic))");
+    assert!(e.contains("boundary"), "{e}");
+}
+
+#[test]
 fn a_bad_solver_is_named() {
     let e = scene_error("(solver: \"rk4\")");
     assert!(e.contains("unknown solver `rk4`"), "{e}");
