@@ -26,8 +26,8 @@ use serde::Serialize;
 use crate::collide::broad_phase::{CellList, Space, overlapping_pairs};
 use crate::collide::collision_space;
 use crate::config::{Boundary, CirclesConfig, Solver};
-use crate::diagnostics::{CollisionCounters, Pressure, Totals, relative_change};
-use crate::run::{headless_app, overlaps, snapshot};
+use crate::diagnostics::{CollisionCounters, Overlaps, Pressure, Totals, relative_change};
+use crate::run::{headless_app, snapshot};
 use crate::spawn::CircleInit;
 
 /// Default simulated time after which positions are compared with the reference: a few
@@ -131,7 +131,7 @@ pub fn trace(case: &Case, solver: Solver, dt: f64) -> Trace {
         stepping += t.elapsed();
         let now = snapshot(app.world_mut());
         tunnelled += passed_through(&before, &now, space);
-        let o = overlaps(app.world_mut());
+        let o = Overlaps::measure(&now, space);
         max_pen = max_pen.max(o.max);
         pen_sum += o.sum;
         pen_pairs += o.pairs;
