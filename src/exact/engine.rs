@@ -1,24 +1,25 @@
 //! The event-driven engine: circles fly in straight lines between events, and events (pair
-//! collisions, wall hits, cell crossings) are processed in time order from a priority queue.
-//! Events carry the collision counters of the circles they involve; an event whose counters
-//! no longer match was invalidated by an earlier event and is dropped when popped.
+//! collisions, wall hits, cell crossings) are processed in time order.
 //!
-//! Each circle keeps only its soonest predicted event in the queue (so the queue holds about N
-//! events, not one per neighbour): when an event pops whose owner is unchanged but whose partner
-//! has moved on, nothing can have happened to the owner before it, so the owner is simply
-//! predicted again from that moment.
+//! Each circle has exactly one pending event, its soonest, held in an indexed [`EventQueue`].
+//! A pair event remembers its partner's collision counter; if the partner has collided since,
+//! the event is stale, and since nothing can have happened to the owner before it, the owner is
+//! simply predicted again from that moment.
 //!
-//! Positions are advanced lazily: circle `i` is at `pos[i] + vel[i]·(t - t_at[i])`. A cell list
-//! (cells at least one largest diameter wide, tracked through cell-crossing events) keeps
-//! prediction local. Everything is f64.
-
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+//! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)`. A cell list (cells
+//! at least one largest diameter wide, tracked through cell-crossing events) keeps prediction
+//! local. A crossing changes no trajectory, so it bumps no counter (events other circles hold
+//! with the crosser stay valid), and the crosser only looks at the three cells it newly
+//! borders, keeping its best pair from before if that partner has not changed: whenever a pair
+//! becomes neighbours, the one that moved looks at the other, and whenever a trajectory
+//! changes, its owner looks at every neighbour. Everything is f64.
 
 use bevy::math::DVec2;
 
+use super::queue::EventQueue;
 use super::toi::{pair_time_of_impact, wall_time_of_impact};
-use crate::boundary::minimum_image;
+use crate::boundary::{minimum_image, reflect_off_walls, wrap_into};
+use crate::config::Arena;
 
 /// One circle as the engine takes it in.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,10 +54,13 @@ pub enum Bounds {
 }
 
 impl Bounds {
-    fn min_and_size(self) -> (DVec2, DVec2) {
+    fn arena(self) -> Arena {
         match self {
-            Bounds::Walls { min, max } => (min, max - min),
-            Bounds::Periodic { min, size } => (min, size),
+            Bounds::Walls { min, max } => Arena { min, max },
+            Bounds::Periodic { min, size } => Arena {
+                min,
+                max: min + size,
+            },
         }
     }
 }
@@ -70,7 +74,8 @@ pub struct EventStats {
     pub wall_collisions: u64,
     /// Cell crossings processed.
     pub cell_crossings: u64,
-    /// Events popped that had been invalidated.
+    /// Pair events dropped because the partner had collided since (the owner was predicted
+    /// again instead).
     pub stale_events: u64,
 
     /// Momentum taken up by the walls, `Σ m |Δv|`.
@@ -81,51 +86,54 @@ pub struct EventStats {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
+    /// Nothing ahead (a resting circle alone).
+    Idle,
     Pair,
-    Wall { axis: u8 },
-    Cell { axis: u8, up: bool },
+    Wall {
+        axis: u8,
+    },
+    Cell {
+        axis: u8,
+        up: bool,
+    },
 }
 
+/// A circle's pending event (its time lives in the queue).
 #[derive(Clone, Copy, Debug)]
 struct Event {
-    time: f64,
     kind: Kind,
-    i: u32,
-    j: u32,
-    count_i: u32,
-    count_j: u32,
+    partner: u32,
+    partner_count: u32,
 }
 
-impl Event {
-    fn key(&self) -> (u32, u32, u8) {
-        let k = match self.kind {
-            Kind::Pair => 0,
-            Kind::Wall { axis } => 1 + axis,
-            Kind::Cell { axis, .. } => 3 + axis,
-        };
-        (self.i, self.j, k)
-    }
+/// The soonest pair collision a circle's last look at its neighbours found.
+#[derive(Clone, Copy, Debug)]
+struct BestPair {
+    time: f64,
+    partner: u32,
+    partner_count: u32,
 }
 
-impl PartialEq for Event {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
+const NO_PAIR: BestPair = BestPair {
+    time: f64::INFINITY,
+    partner: NONE,
+    partner_count: 0,
+};
+
+/// What prediction reads for each circle, kept together for the cache.
+#[derive(Clone, Copy, Debug)]
+struct Motion {
+    /// Position at time `t_at`.
+    pos: DVec2,
+    vel: DVec2,
+    t_at: f64,
+    radius: f64,
 }
-impl Eq for Event {}
-impl PartialOrd for Event {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Event {
-    /// Reversed, so the max-heap pops the earliest event; ties broken by circle indices so the
-    /// order never depends on insertion history.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .time
-            .total_cmp(&self.time)
-            .then_with(|| other.key().cmp(&self.key()))
+
+impl Motion {
+    #[inline]
+    fn at(&self, t: f64) -> DVec2 {
+        self.pos + self.vel * (t - self.t_at)
     }
 }
 
@@ -145,12 +153,14 @@ pub struct EventEngine {
     restitution: f64,
     wall_restitution: f64,
     now: f64,
-    pos: Vec<DVec2>,
-    vel: Vec<DVec2>,
-    t_at: Vec<f64>,
-    radius: Vec<f64>,
+    motion: Vec<Motion>,
     inv_mass: Vec<f64>,
+    /// Collisions (pair or wall) each circle has had: a pair event is valid while its
+    /// partner's count is unchanged.
     counter: Vec<u32>,
+    event: Vec<Event>,
+    best_pair: Vec<BestPair>,
+    queue: EventQueue,
     // Cell list: doubly linked lists per cell, membership updated by crossing events.
     origin: DVec2,
     cell: DVec2,
@@ -161,12 +171,11 @@ pub struct EventEngine {
     head: Vec<u32>,
     next: Vec<u32>,
     prev: Vec<u32>,
-    queue: BinaryHeap<Event>,
     stats: EventStats,
 }
 
 impl EventEngine {
-    /// Builds the engine at time 0 and predicts every circle's first events. Circles must have
+    /// Builds the engine at time 0 and predicts every circle's first event. Circles must have
     /// finite state; with walls their centres must lie within `[min + r, max - r]` (a centre
     /// just outside by rounding is treated as touching the wall).
     pub fn new(
@@ -176,7 +185,8 @@ impl EventEngine {
         wall_restitution: f64,
     ) -> Self {
         let n = circles.len();
-        let (origin, size) = bounds.min_and_size();
+        let arena = bounds.arena();
+        let size = arena.size();
         let largest = circles.iter().map(|c| c.radius).fold(0.0f64, f64::max);
         // Cells at least one largest diameter wide, and no more than about 4 per circle.
         let per_axis_cap = ((4 * n).max(1) as f64).sqrt().ceil().max(1.0);
@@ -185,18 +195,38 @@ impl EventEngine {
             fit.clamp(1.0, per_axis_cap) as usize
         };
         let (cols, rows) = (count(size.x), count(size.y));
+        let periodic = matches!(bounds, Bounds::Periodic { .. });
         let mut engine = Self {
             bounds,
             restitution,
             wall_restitution,
             now: 0.0,
-            pos: circles.iter().map(|c| c.position).collect(),
-            vel: circles.iter().map(|c| c.velocity).collect(),
-            t_at: vec![0.0; n],
-            radius: circles.iter().map(|c| c.radius).collect(),
+            motion: circles
+                .iter()
+                .map(|c| Motion {
+                    pos: if periodic {
+                        wrap_into(c.position, &arena)
+                    } else {
+                        c.position
+                    },
+                    vel: c.velocity,
+                    t_at: 0.0,
+                    radius: c.radius,
+                })
+                .collect(),
             inv_mass: circles.iter().map(|c| c.inv_mass).collect(),
             counter: vec![0; n],
-            origin,
+            event: vec![
+                Event {
+                    kind: Kind::Idle,
+                    partner: NONE,
+                    partner_count: 0
+                };
+                n
+            ],
+            best_pair: vec![NO_PAIR; n],
+            queue: EventQueue::new(n),
+            origin: arena.min,
             cell: DVec2::new(size.x / cols as f64, size.y / rows as f64),
             cols,
             rows,
@@ -205,24 +235,9 @@ impl EventEngine {
             head: vec![NONE; cols * rows],
             next: vec![NONE; n],
             prev: vec![NONE; n],
-            queue: BinaryHeap::with_capacity(16 * n + 16),
             stats: EventStats::default(),
         };
-        for i in 0..n {
-            if let Bounds::Periodic { .. } = bounds {
-                engine.pos[i] = crate::boundary::wrap_into(
-                    engine.pos[i],
-                    &crate::config::Arena {
-                        min: origin,
-                        max: origin + size,
-                    },
-                );
-            }
-            let c = ((engine.pos[i] - origin) / engine.cell).floor();
-            engine.cell_x[i] = (c.x.max(0.0) as usize).min(cols - 1) as u32;
-            engine.cell_y[i] = (c.y.max(0.0) as usize).min(rows - 1) as u32;
-            engine.link(i);
-        }
+        engine.relink_all();
         engine.predict_all();
         engine
     }
@@ -234,12 +249,12 @@ impl EventEngine {
 
     /// Number of circles.
     pub fn len(&self) -> usize {
-        self.pos.len()
+        self.motion.len()
     }
 
     /// Whether there are no circles.
     pub fn is_empty(&self) -> bool {
-        self.pos.is_empty()
+        self.motion.is_empty()
     }
 
     /// What the engine has done so far.
@@ -249,21 +264,18 @@ impl EventEngine {
 
     /// Position of circle `i` now.
     pub fn position(&self, i: usize) -> DVec2 {
-        self.position_at(i, self.now)
+        self.motion[i].at(self.now)
     }
 
     /// Velocity of circle `i`.
     pub fn velocity(&self, i: usize) -> DVec2 {
-        self.vel[i]
-    }
-
-    fn position_at(&self, i: usize, t: f64) -> DVec2 {
-        self.pos[i] + self.vel[i] * (t - self.t_at[i])
+        self.motion[i].vel
     }
 
     fn advance_circle(&mut self, i: usize, t: f64) {
-        self.pos[i] = self.position_at(i, t);
-        self.t_at[i] = t;
+        let m = &mut self.motion[i];
+        m.pos = m.at(t);
+        m.t_at = t;
     }
 
     fn cell_index(&self, i: usize) -> usize {
@@ -294,7 +306,19 @@ impl EventEngine {
         }
     }
 
+    /// Puts every circle in the cell its current position lies in.
+    fn relink_all(&mut self) {
+        self.head.fill(NONE);
+        for i in 0..self.len() {
+            let c = ((self.motion[i].pos - self.origin) / self.cell).floor();
+            self.cell_x[i] = (c.x.max(0.0) as usize).min(self.cols - 1) as u32;
+            self.cell_y[i] = (c.y.max(0.0) as usize).min(self.rows - 1) as u32;
+            self.link(i);
+        }
+    }
+
     /// The displacement from `a` to `b` (minimum image on a periodic box).
+    #[inline]
     fn offset(&self, a: DVec2, b: DVec2) -> DVec2 {
         match self.bounds {
             Bounds::Walls { .. } => b - a,
@@ -302,156 +326,201 @@ impl EventEngine {
         }
     }
 
-    /// The distinct cells of the 3×3 block around circle `i`'s cell.
-    fn neighbourhood(&self, i: usize) -> ([usize; 9], usize) {
-        let periodic = matches!(self.bounds, Bounds::Periodic { .. });
-        let (cx, cy) = (self.cell_x[i] as i64, self.cell_y[i] as i64);
+    /// Cell `(x + dx, y + dy)`, wrapped on a periodic box, `None` past a wall.
+    #[inline]
+    fn shifted_cell(&self, x: u32, y: u32, dx: i64, dy: i64) -> Option<usize> {
         let (cols, rows) = (self.cols as i64, self.rows as i64);
-        let mut cells = [0usize; 9];
-        let mut len = 0;
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                let (mut x, mut y) = (cx + dx, cy + dy);
-                if periodic {
-                    x = x.rem_euclid(cols);
-                    y = y.rem_euclid(rows);
-                } else if x < 0 || y < 0 || x >= cols || y >= rows {
-                    continue;
-                }
-                let c = (y * cols + x) as usize;
-                if !cells[..len].contains(&c) {
-                    cells[len] = c;
-                    len += 1;
-                }
-            }
+        let (mut x, mut y) = (x as i64 + dx, y as i64 + dy);
+        if matches!(self.bounds, Bounds::Periodic { .. }) {
+            x = x.rem_euclid(cols);
+            y = y.rem_euclid(rows);
+        } else if x < 0 || y < 0 || x >= cols || y >= rows {
+            return None;
         }
-        (cells, len)
+        Some((y * cols + x) as usize)
     }
 
-    fn push(&mut self, time: f64, kind: Kind, i: usize, j: u32) {
-        let count_j = if j == NONE {
-            0
-        } else {
-            self.counter[j as usize]
-        };
-        self.queue.push(Event {
-            time,
-            kind,
-            i: i as u32,
-            j,
-            count_i: self.counter[i],
-            count_j,
-        });
-    }
-
-    /// Predicts circle `i`'s soonest event from `now` — a pair collision within its
-    /// neighbourhood, a wall hit or a cell crossing — and queues it.
-    fn predict(&mut self, i: usize) {
+    /// The soonest collision of circle `i` with a circle in `cells`, as seen from now.
+    fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
         let now = self.now;
-        let p = self.position_at(i, now);
-        let v = self.vel[i];
-        let mut soonest: Option<(f64, Kind, u32)> = None;
-        let mut consider = |t: f64, kind: Kind, j: u32| {
-            if soonest.is_none_or(|(best, _, _)| t < best) {
-                soonest = Some((t, kind, j));
-            }
-        };
-        let (cells, len) = self.neighbourhood(i);
-        for &c in &cells[..len] {
+        let me = self.motion[i];
+        let p = me.at(now);
+        let mut best = NO_PAIR;
+        for c in cells {
             let mut j = self.head[c];
             while j != NONE {
                 let ju = j as usize;
+                let other = &self.motion[ju];
                 if ju != i {
-                    let dp = self.offset(p, self.position_at(ju, now));
-                    let dv = self.vel[ju] - v;
-                    if let Some(t) = pair_time_of_impact(dp, dv, self.radius[i] + self.radius[ju]) {
-                        consider(t, Kind::Pair, j);
+                    let dp = self.offset(p, other.at(now));
+                    if let Some(t) =
+                        pair_time_of_impact(dp, other.vel - me.vel, me.radius + other.radius)
+                        && now + t < best.time
+                    {
+                        best = BestPair {
+                            time: now + t,
+                            partner: j,
+                            partner_count: self.counter[ju],
+                        };
                     }
                 }
                 j = self.next[ju];
             }
         }
-        for axis in 0..2u8 {
-            let a = axis as usize;
-            if v[a] == 0.0 {
-                continue;
-            }
-            if let Bounds::Walls { min, max } = self.bounds {
-                let r = self.radius[i];
-                if let Some((t, _)) = wall_time_of_impact(p[a], v[a], min[a] + r, max[a] - r) {
-                    consider(t, Kind::Wall { axis }, NONE);
+        best
+    }
+
+    /// Looks at every circle in the 3×3 block of cells around circle `i` and schedules its
+    /// soonest event.
+    fn predict(&mut self, i: usize) {
+        let (x, y) = (self.cell_x[i], self.cell_y[i]);
+        let (xu, yu) = (x as usize, y as usize);
+        if (1..self.cols - 1).contains(&xu) && (1..self.rows - 1).contains(&yu) {
+            // Away from the edges: nine distinct cells, no wrapping.
+            let c = self.cell_index(i);
+            let cols = self.cols;
+            let block = [c - cols, c, c + cols]
+                .into_iter()
+                .flat_map(|middle| [middle - 1, middle, middle + 1]);
+            self.best_pair[i] = self.scan(i, block);
+            self.schedule(i);
+            return;
+        }
+        let mut cells = [0usize; 9];
+        let mut len = 0;
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                // Tiny periodic grids wrap a cell onto itself; visit each once.
+                if let Some(c) = self.shifted_cell(x, y, dx, dy)
+                    && !cells[..len].contains(&c)
+                {
+                    cells[len] = c;
+                    len += 1;
                 }
             }
-            // Cell crossing along this axis (none past the outer cells of a walled box).
-            let cell = if a == 0 {
-                self.cell_x[i]
+        }
+        self.best_pair[i] = self.scan(i, cells[..len].iter().copied());
+        self.schedule(i);
+    }
+
+    /// After circle `i` crossed into a new cell along `axis`: looks only at the three cells it
+    /// now borders for the first time and keeps the sooner of what it finds there and its best
+    /// pair from before. If that partner has collided since, the pair event is found stale when
+    /// it comes up and the circle looks at all its neighbours then, before anything it could
+    /// have missed.
+    fn predict_after_crossing(&mut self, i: usize, axis: usize, up: bool) {
+        let best = self.best_pair[i];
+        let (x, y) = (self.cell_x[i], self.cell_y[i]);
+        let ahead = if up { 1 } else { -1 };
+        let cells = (-1..=1).filter_map(|side| {
+            let (dx, dy) = if axis == 0 {
+                (ahead, side)
             } else {
-                self.cell_y[i]
-            } as usize;
-            let last = if a == 0 { self.cols } else { self.rows } - 1;
-            let up = v[a] > 0.0;
-            let walls = matches!(self.bounds, Bounds::Walls { .. });
+                (side, ahead)
+            };
+            self.shifted_cell(x, y, dx, dy)
+        });
+        let found = self.scan(i, cells);
+        if found.time < best.time {
+            self.best_pair[i] = found;
+        }
+        self.schedule(i);
+    }
+
+    /// Sets circle `i`'s event to the soonest of its best pair, a wall hit and a cell crossing.
+    fn schedule(&mut self, i: usize) {
+        let m = self.motion[i];
+        let p = m.at(self.now);
+        let best = self.best_pair[i];
+        let (mut time, mut event) = (
+            best.time,
+            Event {
+                kind: if best.partner == NONE {
+                    Kind::Idle
+                } else {
+                    Kind::Pair
+                },
+                partner: best.partner,
+                partner_count: best.partner_count,
+            },
+        );
+        let mut consider = |t: f64, kind: Kind| {
+            if t < time {
+                time = t;
+                event = Event {
+                    kind,
+                    partner: NONE,
+                    partner_count: 0,
+                };
+            }
+        };
+        let walls = matches!(self.bounds, Bounds::Walls { .. });
+        for axis in 0..2u8 {
+            let a = axis as usize;
+            let v = m.vel[a];
+            if v == 0.0 {
+                continue;
+            }
+            if let Bounds::Walls { min, max } = self.bounds
+                && let Some((t, _)) =
+                    wall_time_of_impact(p[a], v, min[a] + m.radius, max[a] - m.radius)
+            {
+                consider(self.now + t, Kind::Wall { axis });
+            }
+            // Cell crossing along this axis (none past the outer cells of a walled box).
+            let (cell, last) = if a == 0 {
+                (self.cell_x[i] as usize, self.cols - 1)
+            } else {
+                (self.cell_y[i] as usize, self.rows - 1)
+            };
+            let up = v > 0.0;
             if walls && ((up && cell == last) || (!up && cell == 0)) {
                 continue;
             }
             let edge = self.origin[a] + self.cell[a] * (cell + usize::from(up)) as f64;
-            let t = ((edge - p[a]) / v[a]).max(0.0);
-            consider(t, Kind::Cell { axis, up }, NONE);
+            consider(
+                self.now + ((edge - p[a]) / v).max(0.0),
+                Kind::Cell { axis, up },
+            );
         }
-        if let Some((t, kind, j)) = soonest {
-            self.push(now + t, kind, i, j);
-        }
+        self.event[i] = event;
+        self.queue.set(i, time);
     }
 
     fn predict_all(&mut self) {
-        self.queue.clear();
         for i in 0..self.len() {
             self.predict(i);
         }
     }
 
-    fn owner_unchanged(&self, e: &Event) -> bool {
-        self.counter[e.i as usize] == e.count_i
-    }
-
-    fn partner_unchanged(&self, e: &Event) -> bool {
-        e.j == NONE || self.counter[e.j as usize] == e.count_j
-    }
-
     /// Processes every event up to time `t_end` and moves the clock there. Stops early (with the
-    /// clock at the last processed event) after `max_events` valid events.
+    /// clock at the last processed event) after `max_events` events.
     pub fn advance_to(&mut self, t_end: f64, max_events: u64) -> Result<u64, BudgetExhausted> {
         let mut processed = 0;
-        while let Some(&event) = self.queue.peek() {
-            if event.time > t_end {
+        while let Some((i, time)) = self.queue.first() {
+            if time > t_end {
                 break;
             }
-            self.queue.pop();
-            if !self.owner_unchanged(&event) {
-                self.stats.stale_events += 1;
-                continue;
-            }
-            if !self.partner_unchanged(&event) {
+            let event = self.event[i];
+            if event.kind == Kind::Pair
+                && self.counter[event.partner as usize] != event.partner_count
+            {
                 // The partner moved on; the owner's path is unchanged up to now: predict again.
                 self.stats.stale_events += 1;
-                self.now = event.time.max(self.now);
-                self.predict(event.i as usize);
+                self.now = time.max(self.now);
+                self.predict(i);
                 continue;
             }
             if processed == max_events {
-                self.queue.push(event);
                 return Err(BudgetExhausted { events: processed });
             }
             processed += 1;
-            self.now = event.time.max(self.now);
+            self.now = time.max(self.now);
             match event.kind {
-                Kind::Pair => self.collide(event.i as usize, event.j as usize),
-                Kind::Wall { axis } => self.hit_wall(event.i as usize, axis as usize),
-                Kind::Cell { axis, up } => self.cross_cell(event.i as usize, axis as usize, up),
-            }
-            // Each circle has one live event; the rest are stale. Start afresh if they pile up.
-            if self.queue.len() > 8 * self.len() + 1024 {
-                self.predict_all();
+                Kind::Pair => self.collide(i, event.partner as usize),
+                Kind::Wall { axis } => self.hit_wall(i, axis as usize),
+                Kind::Cell { axis, up } => self.cross_cell(i, axis as usize, up),
+                Kind::Idle => unreachable!("idle circles wait at +∞"),
             }
         }
         self.now = t_end;
@@ -463,39 +532,21 @@ impl EventEngine {
     /// event budget runs out: collisions skipped here show up as overlapping, approaching pairs,
     /// which collide at once on the next advance.
     pub fn drift_to(&mut self, t: f64) {
-        let (origin, size) = self.bounds.min_and_size();
-        let arena = crate::config::Arena {
-            min: origin,
-            max: origin + size,
-        };
-        for i in 0..self.len() {
-            let mut p = self.position_at(i, t);
+        let arena = self.bounds.arena();
+        for (m, count) in self.motion.iter_mut().zip(&mut self.counter) {
+            let mut p = m.at(t);
             match self.bounds {
                 Bounds::Walls { .. } => {
-                    let mut v = self.vel[i];
-                    crate::boundary::reflect_off_walls(
-                        &mut p,
-                        &mut v,
-                        self.radius[i],
-                        &arena,
-                        self.wall_restitution,
-                    );
-                    self.vel[i] = v;
+                    reflect_off_walls(&mut p, &mut m.vel, m.radius, &arena, self.wall_restitution);
                 }
-                Bounds::Periodic { .. } => p = crate::boundary::wrap_into(p, &arena),
+                Bounds::Periodic { .. } => p = wrap_into(p, &arena),
             }
-            self.pos[i] = p;
-            self.t_at[i] = t;
-            self.counter[i] += 1;
+            m.pos = p;
+            m.t_at = t;
+            *count += 1;
         }
         self.now = t;
-        self.head.fill(NONE);
-        for i in 0..self.len() {
-            let c = ((self.pos[i] - origin) / self.cell).floor();
-            self.cell_x[i] = (c.x.max(0.0) as usize).min(self.cols - 1) as u32;
-            self.cell_y[i] = (c.y.max(0.0) as usize).min(self.rows - 1) as u32;
-            self.link(i);
-        }
+        self.relink_all();
         self.predict_all();
     }
 
@@ -503,23 +554,22 @@ impl EventEngine {
         let now = self.now;
         self.advance_circle(i, now);
         self.advance_circle(j, now);
-        let d = self.offset(self.pos[i], self.pos[j]);
+        let (a, b) = (self.motion[i], self.motion[j]);
+        let d = self.offset(a.pos, b.pos);
         let dist = d.length();
         let n = if dist > 0.0 {
             d / dist
         } else {
-            (self.vel[i] - self.vel[j])
-                .try_normalize()
-                .unwrap_or(DVec2::X)
+            (a.vel - b.vel).try_normalize().unwrap_or(DVec2::X)
         };
-        let approach = (self.vel[j] - self.vel[i]).dot(n);
+        let approach = (b.vel - a.vel).dot(n);
         let w = self.inv_mass[i] + self.inv_mass[j];
         if approach < 0.0 && w > 0.0 {
             let impulse = -(1.0 + self.restitution) * approach / w;
-            self.vel[i] -= n * (impulse * self.inv_mass[i]);
-            self.vel[j] += n * (impulse * self.inv_mass[j]);
+            self.motion[i].vel -= n * (impulse * self.inv_mass[i]);
+            self.motion[j].vel += n * (impulse * self.inv_mass[j]);
             self.stats.pair_collisions += 1;
-            self.stats.virial += (self.radius[i] + self.radius[j]) * impulse;
+            self.stats.virial += (a.radius + b.radius) * impulse;
         }
         self.counter[i] += 1;
         self.counter[j] += 1;
@@ -532,16 +582,16 @@ impl EventEngine {
             return;
         };
         self.advance_circle(i, self.now);
-        let r = self.radius[i];
-        let (lo, hi) = (min[axis] + r, max[axis] - r);
-        let v = self.vel[i][axis];
+        let m = &mut self.motion[i];
+        let (lo, hi) = (min[axis] + m.radius, max[axis] - m.radius);
+        let v = m.vel[axis];
         // Snap onto the wall (the event time puts it there up to rounding) and reflect.
-        self.pos[i][axis] = if v > 0.0 { hi } else { lo };
+        m.pos[axis] = if v > 0.0 { hi } else { lo };
         let new_v = -self.wall_restitution * v;
+        m.vel[axis] = new_v;
         if self.inv_mass[i] > 0.0 {
             self.stats.wall_impulse += (new_v - v).abs() / self.inv_mass[i];
         }
-        self.vel[i][axis] = new_v;
         self.stats.wall_collisions += 1;
         self.counter[i] += 1;
         self.predict(i);
@@ -571,12 +621,11 @@ impl EventEngine {
         if wrapped != 0.0
             && let Bounds::Periodic { size, .. } = self.bounds
         {
-            self.pos[i][axis] += wrapped * size[axis];
+            self.motion[i].pos[axis] += wrapped * size[axis];
         }
         self.link(i);
         self.stats.cell_crossings += 1;
-        self.counter[i] += 1;
-        self.predict(i);
+        self.predict_after_crossing(i, axis, up);
     }
 }
 

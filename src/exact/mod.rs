@@ -10,6 +10,7 @@
 //! [`ContinuousStep`](crate::schedule::ContinuousStep) schedule after the force effects.
 
 pub mod engine;
+pub mod queue;
 pub mod toi;
 
 use bevy::math::DVec2;

@@ -1,0 +1,110 @@
+//! The event engine's priority queue: a tournament tree holding exactly one time per circle.
+//! Changing a circle's time replays at most log₂ N matches on its path to the root, and usually
+//! stops much earlier, so the queue never fills with superseded events and never has to skip
+//! them when popping. (The std `BinaryHeap` cannot change a key; the indexed-queue crates go
+//! through a hash map, which costs more than a whole event here; an indexed 4-ary heap measured
+//! about 5 % slower on the 10k gas.)
+//!
+//! Ties are broken by circle index, so the order never depends on the history of updates.
+
+/// Min-queue of `(time, circle)` with one entry per circle.
+#[derive(Clone, Debug, Default)]
+pub struct EventQueue {
+    /// Complete binary tree in an array: leaves at `leaves..2·leaves` (circle `i` at
+    /// `leaves + i`), each inner node `k` holding the earlier of its children `2k` and `2k + 1`,
+    /// so node 1 holds the earliest of all. Siblings sit side by side in one cache line.
+    node: Vec<Entry>,
+    leaves: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Entry {
+    time: f64,
+    circle: u32,
+}
+
+impl Entry {
+    const NEVER: Entry = Entry {
+        time: f64::INFINITY,
+        circle: u32::MAX,
+    };
+
+    #[inline]
+    fn earlier(a: Entry, b: Entry) -> Entry {
+        if b.time < a.time || (b.time == a.time && b.circle < a.circle) {
+            b
+        } else {
+            a
+        }
+    }
+}
+
+impl EventQueue {
+    /// A queue of `n` circles, all at time `+∞`.
+    pub fn new(n: usize) -> Self {
+        let leaves = n.next_power_of_two().max(2);
+        let mut node = vec![Entry::NEVER; 2 * leaves];
+        for (i, leaf) in node[leaves..leaves + n].iter_mut().enumerate() {
+            leaf.circle = i as u32;
+        }
+        for k in (1..leaves).rev() {
+            node[k] = Entry::earlier(node[2 * k], node[2 * k + 1]);
+        }
+        Self { node, leaves }
+    }
+
+    /// The circle with the earliest time, and that time.
+    #[inline]
+    pub fn first(&self) -> Option<(usize, f64)> {
+        let top = self.node[1];
+        (top.circle != u32::MAX).then_some((top.circle as usize, top.time))
+    }
+
+    /// Sets circle `i`'s time and replays the matches on its path to the root, stopping where
+    /// a node's winner does not change.
+    pub fn set(&mut self, i: usize, time: f64) {
+        let mut k = self.leaves + i;
+        self.node[k].time = time;
+        while k > 1 {
+            let parent = k / 2;
+            let winner = Entry::earlier(self.node[2 * parent], self.node[2 * parent + 1]);
+            if self.node[parent] == winner {
+                break;
+            }
+            self.node[parent] = winner;
+            k = parent;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pops_in_time_order_through_any_sequence_of_updates() {
+        // A fixed pseudo-random sequence of updates, checked against a sort after each one.
+        let n = 37;
+        let mut q = EventQueue::new(n);
+        let mut times = vec![f64::INFINITY; n];
+        let mut x: u64 = 12345;
+        for _ in 0..2000 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let i = (x >> 33) as usize % n;
+            let t = ((x >> 11) % 50) as f64; // many ties
+            q.set(i, t);
+            times[i] = t;
+            let want = (0..n)
+                .min_by(|&a, &b| times[a].total_cmp(&times[b]).then(a.cmp(&b)))
+                .unwrap();
+            assert_eq!(q.first(), Some((want, times[want])));
+        }
+    }
+
+    #[test]
+    fn an_empty_queue_has_no_first() {
+        assert_eq!(EventQueue::new(0).first(), None);
+    }
+}
