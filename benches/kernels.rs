@@ -88,9 +88,10 @@ fn contact_pass(c: &mut Criterion) {
         group.throughput(Throughput::Elements(n as u64));
         group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
-                let work = scratch.bodies_mut();
-                work.clear();
-                work.extend_from_slice(&bodies);
+                scratch.clear();
+                for &body in &bodies {
+                    scratch.push(body);
+                }
                 black_box(resolve_all_contacts(&mut scratch, Space::Open, 1.0))
             })
         });

@@ -121,6 +121,10 @@ struct RunArgs {
     /// Write the final state here, in the particle format.
     #[arg(long, value_name = "PATH.txt")]
     dump: Option<PathBuf>,
+    /// Threads for the parallel parts of a step (default: one per core). Results do not depend
+    /// on it.
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
 }
 
 /// A fixed solver, or `auto`.
@@ -245,6 +249,14 @@ fn run(args: RunArgs) -> anyhow::Result<()> {
         (None, None) => unreachable!("clap requires --seconds or --steps"),
     };
 
+    if let Some(threads) = args.threads {
+        // Set up before the App, whose task pool plugin keeps a pool that already exists.
+        bevy::tasks::ComputeTaskPool::get_or_init(|| {
+            bevy::tasks::TaskPoolBuilder::new()
+                .num_threads(threads.into())
+                .build()
+        });
+    }
     let mut app = headless_app(config);
     let spawn = *app.world().resource::<SpawnReport>();
     if spawn.placed < spawn.requested {

@@ -203,3 +203,31 @@ fn a_closed_stdout_is_not_a_crash() {
     assert!(report.exists(), "the report is still written");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_final_state_does_not_depend_on_the_number_of_threads() {
+    // 10k circles: above the size from which the broad phase and the contact pass go parallel.
+    let dir = temp_dir("threads");
+    let mut dumps = Vec::new();
+    for threads in ["1", "2", "5"] {
+        let dump = dir.join(format!("threads-{threads}.txt"));
+        moving_circles(&[
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--steps",
+            "30",
+            "--threads",
+            threads,
+            "--dump",
+            dump.to_str().unwrap(),
+        ]);
+        dumps.push(std::fs::read_to_string(&dump).unwrap());
+    }
+    assert!(dumps[0].lines().count() > 10_000);
+    assert!(
+        dumps.iter().all(|d| *d == dumps[0]),
+        "states differ by thread count"
+    );
+    std::fs::remove_dir_all(dir).ok();
+}

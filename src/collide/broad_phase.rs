@@ -6,7 +6,28 @@
 //! four of its eight neighbours (the "half stencil").
 
 use bevy::math::DVec2;
-use bevy::tasks::{ComputeTaskPool, TaskPool};
+use bevy::tasks::{ComputeTaskPool, ParallelSliceMut, TaskPool};
+
+/// A circle as the broad phase sees it: a centre and a radius. Implemented for `(centre,
+/// radius)` and for the contact kernel's [`Body`](super::contact::Body), so the discrete solver
+/// can bucket and scan its bodies without copying them out first.
+pub trait Disc: Copy + Send + Sync {
+    /// Centre.
+    fn centre(&self) -> DVec2;
+    /// Radius.
+    fn radius(&self) -> f64;
+}
+
+impl Disc for (DVec2, f64) {
+    #[inline]
+    fn centre(&self) -> DVec2 {
+        self.0
+    }
+    #[inline]
+    fn radius(&self) -> f64 {
+        self.1
+    }
+}
 
 /// Circles bucketed by cell: `order[start[c]..start[c + 1]]` are the circles in cell `c`.
 #[derive(Debug, Default, Clone)]
@@ -21,6 +42,8 @@ pub struct CellList {
     start: Vec<u32>,
     order: Vec<u32>,
     cell_of: Vec<u32>,
+    /// Next free slot per cell while filling `order`.
+    cursor: Vec<u32>,
     /// Positions and radii in `order`, reused by [`overlapping_pairs`].
     sorted: Vec<(DVec2, f64)>,
 }
@@ -32,12 +55,13 @@ impl CellList {
     /// Buckets `positions` into cells at least `min_cell` wide. The grid covers the bounding box
     /// of the finite positions, and never has more than about four cells per circle (a tiny
     /// radius in a huge box gets wider cells, which stays correct and bounds memory).
-    pub fn rebuild(&mut self, positions: &[DVec2], min_cell: f64) {
-        let n = positions.len();
-        let (lo, hi) = positions
+    pub fn rebuild<T: Disc>(&mut self, circles: &[T], min_cell: f64) {
+        let n = circles.len();
+        let (lo, hi) = circles
             .iter()
+            .map(Disc::centre)
             .filter(|p| p.is_finite())
-            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
                 (lo.min(p), hi.max(p))
             });
         let extent = if lo.x <= hi.x { hi - lo } else { DVec2::ZERO };
@@ -56,19 +80,19 @@ impl CellList {
         self.y_scale = 1.0;
         self.cols = ((extent.x * self.inv_cell).floor() as usize + 1).max(1);
         self.rows = ((extent.y * self.inv_cell).floor() as usize + 1).max(1);
-        self.fill(positions);
+        self.fill(circles);
     }
 
     /// Buckets `positions` (already wrapped into the periodic box at `min` of this `size`) into
     /// a grid that tiles the box exactly, with cells at least `min_cell` wide.
-    pub fn rebuild_periodic(
+    pub fn rebuild_periodic<T: Disc>(
         &mut self,
-        positions: &[DVec2],
+        circles: &[T],
         min: DVec2,
         size: DVec2,
         min_cell: f64,
     ) {
-        let max_per_axis = ((4 * positions.len()).max(1) as f64).sqrt().ceil();
+        let max_per_axis = ((4 * circles.len()).max(1) as f64).sqrt().ceil();
         let per_axis = |length: f64| {
             let n = (length / min_cell.max(f64::MIN_POSITIVE)).floor();
             (n.min(max_per_axis) as usize).max(1)
@@ -80,7 +104,7 @@ impl CellList {
         // Cells may be non-square here; `inv_cell` is per x, and y is rescaled by the ratio.
         self.inv_cell = self.cols as f64 / size.x;
         self.y_scale = (self.rows as f64 / size.y) / self.inv_cell;
-        self.fill(positions);
+        self.fill(circles);
     }
 
     /// Whether the periodic grid is too coarse for the wrapped half stencil to visit each
@@ -89,12 +113,23 @@ impl CellList {
         self.periodic && (self.cols < 3 || self.rows < 3)
     }
 
-    fn fill(&mut self, positions: &[DVec2]) {
+    /// The circles' input indices in cell order (circles with a non-finite centre left out).
+    pub fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    fn fill<T: Disc>(&mut self, circles: &[T]) {
         let cells = self.cols * self.rows;
 
         let mut cell_of = std::mem::take(&mut self.cell_of);
         cell_of.clear();
-        cell_of.extend(positions.iter().map(|&p| self.cell_index(p)));
+        cell_of.resize(circles.len(), NO_CELL);
+        let this = &*self;
+        map_chunks(&mut cell_of, |from, out| {
+            for (cell, c) in out.iter_mut().zip(&circles[from..]) {
+                *cell = this.cell_index(c.centre());
+            }
+        });
         self.cell_of = cell_of;
         self.start.clear();
         self.start.resize(cells + 1, 0);
@@ -109,10 +144,11 @@ impl CellList {
         let placed = self.start[cells] as usize;
         self.order.clear();
         self.order.resize(placed, 0);
-        let mut fill = self.start[..cells].to_vec();
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.start[..cells]);
         for (i, &c) in self.cell_of.iter().enumerate() {
             if c != NO_CELL {
-                let slot = &mut fill[c as usize];
+                let slot = &mut self.cursor[c as usize];
                 self.order[*slot as usize] = i as u32;
                 *slot += 1;
             }
@@ -173,23 +209,39 @@ impl CellList {
         self.start[c] as usize..self.start[c + 1] as usize
     }
 
-    fn half_stencil(&self, x: usize, y: usize) -> [Option<(usize, usize)>; 4] {
+    /// The circles (as ranges of positions in [`Self::order`]) that a circle of cell `(x, y)`
+    /// is tested against: its own cell (the caller skips up to itself) and the "half stencil"
+    /// (the cell to the right and the three above). Neighbouring cells of a row are adjacent in
+    /// the order, so away from a periodic seam this is two contiguous ranges.
+    #[inline]
+    fn later_neighbours(&self, x: usize, y: usize) -> ([std::ops::Range<usize>; 5], usize) {
         let (cols, rows) = (self.cols, self.rows);
-        if self.periodic {
-            let (right, left, up) = ((x + 1) % cols, (x + cols - 1) % cols, (y + 1) % rows);
-            return [
-                Some((right, y)),
-                Some((left, up)),
-                Some((x, up)),
-                Some((right, up)),
-            ];
+        let at = |x: usize, y: usize| self.start[y * cols + x] as usize;
+        let end = |x: usize, y: usize| self.start[y * cols + x + 1] as usize;
+        let mut ranges: [std::ops::Range<usize>; 5] = Default::default();
+        let mut len = 0;
+        let mut add = |r: std::ops::Range<usize>| {
+            if len > 0 && ranges[len - 1].end == r.start {
+                ranges[len - 1].end = r.end;
+            } else if !r.is_empty() {
+                ranges[len] = r;
+                len += 1;
+            }
+        };
+        if !self.periodic {
+            add(at(x, y)..end((x + 1).min(cols - 1), y));
+            if y + 1 < rows {
+                add(at(x.saturating_sub(1), y + 1)..end((x + 1).min(cols - 1), y + 1));
+            }
+            return (ranges, len);
         }
-        [
-            (x + 1 < cols).then(|| (x + 1, y)),
-            (y + 1 < rows && x > 0).then(|| (x - 1, y + 1)),
-            (y + 1 < rows).then(|| (x, y + 1)),
-            (y + 1 < rows && x + 1 < cols).then(|| (x + 1, y + 1)),
-        ]
+        let (right, left, up) = ((x + 1) % cols, (x + cols - 1) % cols, (y + 1) % rows);
+        add(at(x, y)..end(x, y));
+        add(at(right, y)..end(right, y));
+        for cx in [left, x, right] {
+            add(at(cx, up)..end(cx, up));
+        }
+        (ranges, len)
     }
 }
 
@@ -218,40 +270,89 @@ impl Space {
     }
 }
 
-/// Circle count from which the pair scan runs on all cores.
+/// Circle count from which the pair scan and the per-circle passes run on all cores.
 pub const PARALLEL_FROM: usize = 4_000;
+
+/// Fills `out` by calling `fill(offset, chunk)` on chunks of it, on all cores when it is long
+/// (each element depends only on its index, so the result does not depend on the threads).
+fn map_chunks<T: Send>(mut out: &mut [T], fill: impl Fn(usize, &mut [T]) + Send + Sync) {
+    const CHUNK: usize = 1 << 14;
+    if out.len() < PARALLEL_FROM {
+        fill(0, out);
+        return;
+    }
+    let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+    out.par_chunk_map_mut(pool, CHUNK, |index, chunk| fill(index * CHUNK, chunk));
+}
 
 /// Scans the cells of `rows`, appending overlapping pairs: per circle (in cell order), the rest
 /// of its own cell, then the half stencil's cells. Visiting circles rather than cells skips the
 /// empty cells, which outnumber circles in a sparse gas.
-fn scan_rows(
+fn scan_rows<T: Disc>(
     cells: &CellList,
-    sorted: &[(DVec2, f64)],
+    sorted: &[T],
     space: Space,
     rows: std::ops::Range<usize>,
     pairs: &mut Vec<(u32, u32)>,
 ) {
+    match space {
+        Space::Open => scan_rows_with(cells, sorted, |a, b| b - a, rows, pairs),
+        Space::Periodic { size, .. } => scan_rows_with(
+            cells,
+            sorted,
+            |a, b| crate::boundary::minimum_image(b - a, size),
+            rows,
+            pairs,
+        ),
+    }
+}
+
+/// [`scan_rows`] with the displacement function fixed at compile time.
+fn scan_rows_with<T: Disc>(
+    cells: &CellList,
+    sorted: &[T],
+    offset: impl Fn(DVec2, DVec2) -> DVec2,
+    rows: std::ops::Range<usize>,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    let (cols, start) = (cells.cols, &cells.start);
     for y in rows {
-        for x in 0..cells.cols {
-            let here = cells.range(x, y);
+        let row = y * cols;
+        for x in 0..cols {
+            let here = start[row + x] as usize..start[row + x + 1] as usize;
             if here.is_empty() {
                 continue;
             }
-            let mut stencil = [0..0, 0..0, 0..0, 0..0];
-            for (slot, cell) in stencil.iter_mut().zip(cells.half_stencil(x, y)) {
-                if let Some((nx, ny)) = cell {
-                    *slot = cells.range(nx, ny);
+            let (ranges, len) = if cells.periodic {
+                cells.later_neighbours(x, y)
+            } else {
+                // Open grid, written out: own and right cell, then the three cells above.
+                let right = (x + 1).min(cols - 1);
+                let mut ranges: [std::ops::Range<usize>; 5] = Default::default();
+                ranges[0] = here.start..start[row + right + 1] as usize;
+                if y + 1 < cells.rows {
+                    let up = row + cols;
+                    ranges[1] =
+                        start[up + x.saturating_sub(1)] as usize..start[up + right + 1] as usize;
                 }
-            }
+                (ranges, 2)
+            };
             for k in here.clone() {
-                let (p, r) = sorted[k];
-                for l in (k + 1..here.end).chain(stencil.iter().flat_map(Clone::clone)) {
-                    let (q, s) = sorted[l];
-                    let reach = r + s;
-                    if space.offset(p, q).length_squared() < reach * reach {
-                        let (i, j) = (cells.order[k], cells.order[l]);
-                        if i != j {
-                            pairs.push((i.min(j), i.max(j)));
+                let (p, r) = (sorted[k].centre(), sorted[k].radius());
+                for range in &ranges[..len] {
+                    // Within its own cell a circle meets only the ones after it.
+                    let from = if range.contains(&k) {
+                        k + 1
+                    } else {
+                        range.start
+                    };
+                    for (l, other) in sorted[from..range.end].iter().enumerate() {
+                        let reach = r + other.radius();
+                        if offset(p, other.centre()).length_squared() < reach * reach {
+                            let (k, l) = (k as u32, (from + l) as u32);
+                            // Oriented so the first has the lower input index.
+                            let lower_first = cells.order[k as usize] < cells.order[l as usize];
+                            pairs.push(if lower_first { (k, l) } else { (l, k) });
                         }
                     }
                 }
@@ -264,6 +365,14 @@ fn scan_rows(
 /// levels of similar size, each with its own grid: one grid sized for the largest circle would
 /// put thousands of small circles in each cell.
 pub const MULTI_LEVEL_RATIO: f64 = 8.0;
+
+/// Whether the radii span more than [`MULTI_LEVEL_RATIO`], so that one grid would be slow.
+pub fn needs_levels<T: Disc>(circles: &[T]) -> bool {
+    let (r_min, r_max) = circles.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
+        (lo.min(c.radius()), hi.max(c.radius()))
+    });
+    r_min > 0.0 && r_max > MULTI_LEVEL_RATIO * r_min
+}
 
 /// Appends to `pairs` every pair `(i, j)`, `i < j`, of circles that overlap (centre distance
 /// below the sum of radii). The order depends only on the input, not on the number of threads.
@@ -278,26 +387,54 @@ pub fn overlapping_pairs(
     radii: &[f64],
     pairs: &mut Vec<(u32, u32)>,
 ) {
-    let (r_min, r_max) = radii.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| {
-        (lo.min(r), hi.max(r))
-    });
-    if r_min <= 0.0 || r_min.is_nan() || r_max <= MULTI_LEVEL_RATIO * r_min {
-        single_level_pairs(cells, space, positions, radii, pairs);
+    let circles: Vec<(DVec2, f64)> = positions
+        .iter()
+        .copied()
+        .zip(radii.iter().copied())
+        .collect();
+    pairs_among(cells, space, &circles, pairs);
+}
+
+/// [`overlapping_pairs`] of `(centre, radius)` circles.
+pub fn pairs_among(
+    cells: &mut CellList,
+    space: Space,
+    circles: &[(DVec2, f64)],
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    if needs_levels(circles) {
+        let r_min = circles.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+        multi_level_pairs(space, circles, r_min, pairs);
     } else {
-        multi_level_pairs(space, positions, radii, r_min, pairs);
+        single_level_pairs(cells, space, circles, pairs);
+    }
+}
+
+/// [`pairs_in_cell_order`] translated back to input indices.
+fn single_level_pairs(
+    cells: &mut CellList,
+    space: Space,
+    circles: &[(DVec2, f64)],
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    let start = pairs.len();
+    let mut sorted = std::mem::take(&mut cells.sorted);
+    pairs_in_cell_order(cells, space, circles, &mut sorted, pairs);
+    cells.sorted = sorted;
+    for pair in &mut pairs[start..] {
+        *pair = (cells.order[pair.0 as usize], cells.order[pair.1 as usize]);
     }
 }
 
 fn multi_level_pairs(
     space: Space,
-    positions: &[DVec2],
-    radii: &[f64],
+    circles: &[(DVec2, f64)],
     r_min: f64,
     pairs: &mut Vec<(u32, u32)>,
 ) {
     let level_of = |r: f64| ((r / r_min).log2() / 2.0).floor().max(0.0) as usize;
     let mut members: Vec<Vec<u32>> = Vec::new();
-    for (i, &r) in radii.iter().enumerate() {
+    for (i, &(_, r)) in circles.iter().enumerate() {
         let l = level_of(r);
         if members.len() <= l {
             members.resize(l + 1, Vec::new());
@@ -312,16 +449,15 @@ fn multi_level_pairs(
     let mut levels: Vec<Level> = Vec::with_capacity(members.len());
     let start = pairs.len();
     for members in members {
-        let pos: Vec<DVec2> = members.iter().map(|&i| positions[i as usize]).collect();
-        let rad: Vec<f64> = members.iter().map(|&i| radii[i as usize]).collect();
+        let own: Vec<(DVec2, f64)> = members.iter().map(|&i| circles[i as usize]).collect();
         let mut cells = CellList::default();
         let mut local = Vec::new();
-        single_level_pairs(&mut cells, space, &pos, &rad, &mut local);
+        single_level_pairs(&mut cells, space, &own, &mut local);
         pairs.extend(local.into_iter().map(|(a, b)| {
             let (i, j) = (members[a as usize], members[b as usize]);
             (i.min(j), i.max(j))
         }));
-        let max_radius = rad.iter().copied().fold(0.0f64, f64::max);
+        let max_radius = own.iter().map(|c| c.1).fold(0.0f64, f64::max);
         levels.push(Level {
             members,
             cells,
@@ -331,7 +467,7 @@ fn multi_level_pairs(
     // Each circle against the finer levels: the cells its reach could touch.
     for (m, coarse) in levels.iter().enumerate() {
         for &a in &coarse.members {
-            let (p, r) = (positions[a as usize], radii[a as usize]);
+            let (p, r) = circles[a as usize];
             for fine in &levels[..m] {
                 if fine.members.is_empty() {
                     continue;
@@ -339,8 +475,8 @@ fn multi_level_pairs(
                 let reach = DVec2::splat(r + fine.max_radius);
                 fine.cells.for_each_in_box(p - reach, p + reach, |k| {
                     let b = fine.members[fine.cells.order[k] as usize];
-                    let sigma = r + radii[b as usize];
-                    if space.offset(p, positions[b as usize]).length_squared() < sigma * sigma {
+                    let (q, s) = circles[b as usize];
+                    if space.offset(p, q).length_squared() < (r + s) * (r + s) {
                         pairs.push((a.min(b), a.max(b)));
                     }
                 });
@@ -359,41 +495,45 @@ fn sort_and_dedupe(pairs: &mut Vec<(u32, u32)>, start: usize) {
     pairs.append(&mut found);
 }
 
-/// [`overlapping_pairs`] on one uniform grid with cells one largest diameter wide.
+/// The single-grid broad phase, for circles of similar size (see [`needs_levels`]): buckets
+/// `circles` into `cells` (one largest diameter wide), copies them into `sorted` in cell order
+/// ([`CellList::order`]) and appends the overlapping pairs as positions in that order, each
+/// pair's first member being the one with the lower input index.
 ///
-/// The scan runs over copies of the positions and radii laid out in cell order, so the inner
-/// loops read contiguous memory instead of jumping through the circles in entity order.
-fn single_level_pairs(
+/// Working in cell order keeps the scan, and whatever the caller does with the pairs, on
+/// nearby memory instead of jumping through the circles in input order.
+pub fn pairs_in_cell_order<T: Disc>(
     cells: &mut CellList,
     space: Space,
-    positions: &[DVec2],
-    radii: &[f64],
+    circles: &[T],
+    sorted: &mut Vec<T>,
     pairs: &mut Vec<(u32, u32)>,
 ) {
-    let max_radius = radii.iter().copied().fold(0.0f64, f64::max);
+    let max_radius = circles.iter().map(Disc::radius).fold(0.0f64, f64::max);
     match space {
-        Space::Open => cells.rebuild(positions, 2.0 * max_radius),
+        Space::Open => cells.rebuild(circles, 2.0 * max_radius),
         Space::Periodic { min, size } => {
-            cells.rebuild_periodic(positions, min, size, 2.0 * max_radius)
+            cells.rebuild_periodic(circles, min, size, 2.0 * max_radius)
         }
     }
     let start = pairs.len();
-    let mut sorted = std::mem::take(&mut cells.sorted);
     sorted.clear();
-    sorted.extend(
-        cells
-            .order
-            .iter()
-            .map(|&i| (positions[i as usize], radii[i as usize])),
-    );
-    if positions.len() >= PARALLEL_FROM {
+    if let Some(&any) = circles.first() {
+        sorted.resize(cells.order.len(), any);
+        map_chunks(sorted, |from, out| {
+            for (slot, &i) in out.iter_mut().zip(&cells.order[from..]) {
+                *slot = circles[i as usize];
+            }
+        });
+    }
+    if circles.len() >= PARALLEL_FROM {
         // Rows are independent: scan bands of rows on the task pool and append each band's
         // pairs in row order, so the result does not depend on the number of threads.
         let pool = ComputeTaskPool::get_or_init(TaskPool::default);
         let bands = (pool.thread_num() * 4).clamp(1, cells.rows);
         let per_band = cells.rows.div_ceil(bands);
         let cells = &*cells;
-        let sorted = &sorted;
+        let sorted = &*sorted;
         let found = pool.scope(|scope| {
             for band in 0..bands {
                 let rows = band * per_band..((band + 1) * per_band).min(cells.rows);
@@ -408,9 +548,8 @@ fn single_level_pairs(
             pairs.extend(band);
         }
     } else {
-        scan_rows(cells, &sorted, space, 0..cells.rows, pairs);
+        scan_rows(cells, sorted, space, 0..cells.rows, pairs);
     }
-    cells.sorted = sorted;
     if cells.wraps_onto_itself() {
         sort_and_dedupe(pairs, start);
     }
@@ -522,6 +661,9 @@ mod tests {
             // One band over all rows: what a single thread does.
             let mut sequential = Vec::new();
             scan_rows(&cells, &cells.sorted, space, 0..cells.rows, &mut sequential);
+            for pair in &mut sequential {
+                *pair = (cells.order[pair.0 as usize], cells.order[pair.1 as usize]);
+            }
             assert!(parallel.len() > 1000, "{}", parallel.len());
             assert_eq!(parallel, sequential);
         }

@@ -452,20 +452,22 @@ pub fn separate_overlaps(circles: &mut [CircleInit], arena: &Arena, boundary: Bo
     let space = crate::collide::collision_space(arena, boundary);
     let mut scratch = ContactScratch::default();
     for _ in 0..1000 {
-        scratch.bodies_mut().clear();
-        scratch.bodies_mut().extend(circles.iter().map(|c| Body {
-            position: c.position,
-            velocity: DVec2::ZERO, // no impulses: only positions move
-            radius: c.radius,
-            inv_mass: if c.mass.is_finite() {
-                1.0 / c.mass
-            } else {
-                0.0
-            },
-        }));
+        scratch.clear();
+        for c in circles.iter() {
+            scratch.push(Body {
+                position: c.position,
+                velocity: DVec2::ZERO, // no impulses: only positions move
+                radius: c.radius,
+                inv_mass: if c.mass.is_finite() {
+                    1.0 / c.mass
+                } else {
+                    0.0
+                },
+            });
+        }
         let stats = resolve_all_contacts(&mut scratch, space, 1.0);
-        for (c, b) in circles.iter_mut().zip(scratch.bodies_mut().iter()) {
-            let mut p = b.position;
+        for (i, c) in circles.iter_mut().enumerate() {
+            let mut p = scratch.body(i).position;
             let mut v = DVec2::ZERO;
             match boundary {
                 Boundary::Walls => {
