@@ -8,26 +8,8 @@
 use bevy::math::DVec2;
 use bevy::tasks::{ComputeTaskPool, ParallelSliceMut, TaskPool};
 
-/// A circle as the broad phase sees it: a centre and a radius. Implemented for `(centre,
-/// radius)` and for the contact kernel's [`Body`](super::contact::Body), so the discrete solver
-/// can bucket and scan its bodies without copying them out first.
-pub trait Disc: Copy + Send + Sync {
-    /// Centre.
-    fn centre(&self) -> DVec2;
-    /// Radius.
-    fn radius(&self) -> f64;
-}
-
-impl Disc for (DVec2, f64) {
-    #[inline]
-    fn centre(&self) -> DVec2 {
-        self.0
-    }
-    #[inline]
-    fn radius(&self) -> f64 {
-        self.1
-    }
-}
+/// A circle as the broad phase sees it: `(centre, radius)`.
+pub type Disc = (DVec2, f64);
 
 /// Circles bucketed by cell: `order[start[c]..start[c + 1]]` are the circles in cell `c`.
 #[derive(Debug, Default, Clone)]
@@ -55,11 +37,11 @@ impl CellList {
     /// Buckets `positions` into cells at least `min_cell` wide. The grid covers the bounding box
     /// of the finite positions, and never has more than about four cells per circle (a tiny
     /// radius in a huge box gets wider cells, which stays correct and bounds memory).
-    pub fn rebuild<T: Disc>(&mut self, circles: &[T], min_cell: f64) {
+    pub fn rebuild(&mut self, circles: &[Disc], min_cell: f64) {
         let n = circles.len();
         let (lo, hi) = circles
             .iter()
-            .map(Disc::centre)
+            .map(|c| c.0)
             .filter(|p| p.is_finite())
             .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
                 (lo.min(p), hi.max(p))
@@ -85,13 +67,7 @@ impl CellList {
 
     /// Buckets `positions` (already wrapped into the periodic box at `min` of this `size`) into
     /// a grid that tiles the box exactly, with cells at least `min_cell` wide.
-    pub fn rebuild_periodic<T: Disc>(
-        &mut self,
-        circles: &[T],
-        min: DVec2,
-        size: DVec2,
-        min_cell: f64,
-    ) {
+    pub fn rebuild_periodic(&mut self, circles: &[Disc], min: DVec2, size: DVec2, min_cell: f64) {
         let max_per_axis = ((4 * circles.len()).max(1) as f64).sqrt().ceil();
         let per_axis = |length: f64| {
             let n = (length / min_cell.max(f64::MIN_POSITIVE)).floor();
@@ -118,7 +94,7 @@ impl CellList {
         &self.order
     }
 
-    fn fill<T: Disc>(&mut self, circles: &[T]) {
+    fn fill(&mut self, circles: &[Disc]) {
         let cells = self.cols * self.rows;
 
         let mut cell_of = std::mem::take(&mut self.cell_of);
@@ -127,7 +103,7 @@ impl CellList {
         let this = &*self;
         map_chunks(&mut cell_of, |from, out| {
             for (cell, c) in out.iter_mut().zip(&circles[from..]) {
-                *cell = this.cell_index(c.centre());
+                *cell = this.cell_index(c.0);
             }
         });
         self.cell_of = cell_of;
@@ -209,12 +185,16 @@ impl CellList {
         self.start[c] as usize..self.start[c + 1] as usize
     }
 
-    /// The circles (as ranges of positions in [`Self::order`]) that a circle of cell `(x, y)`
-    /// is tested against: its own cell (the caller skips up to itself) and the "half stencil"
-    /// (the cell to the right and the three above). Neighbouring cells of a row are adjacent in
-    /// the order, so away from a periodic seam this is two contiguous ranges.
-    #[inline]
-    fn later_neighbours(&self, x: usize, y: usize) -> ([std::ops::Range<usize>; 5], usize) {
+    /// On a periodic grid, the circles (as ranges of positions in [`Self::order`]) that a
+    /// circle of cell `(x, y)` is tested against: its own cell (the caller skips up to itself)
+    /// and the "half stencil" (the cell to the right and the three above), wrapped around the
+    /// seams. Ranges that meet are merged. (The open grid's two ranges are written out in
+    /// [`scan_rows_with`].)
+    fn periodic_later_neighbours(
+        &self,
+        x: usize,
+        y: usize,
+    ) -> ([std::ops::Range<usize>; 5], usize) {
         let (cols, rows) = (self.cols, self.rows);
         let at = |x: usize, y: usize| self.start[y * cols + x] as usize;
         let end = |x: usize, y: usize| self.start[y * cols + x + 1] as usize;
@@ -228,13 +208,6 @@ impl CellList {
                 len += 1;
             }
         };
-        if !self.periodic {
-            add(at(x, y)..end((x + 1).min(cols - 1), y));
-            if y + 1 < rows {
-                add(at(x.saturating_sub(1), y + 1)..end((x + 1).min(cols - 1), y + 1));
-            }
-            return (ranges, len);
-        }
         let (right, left, up) = ((x + 1) % cols, (x + cols - 1) % cols, (y + 1) % rows);
         add(at(x, y)..end(x, y));
         add(at(right, y)..end(right, y));
@@ -288,9 +261,9 @@ fn map_chunks<T: Send>(mut out: &mut [T], fill: impl Fn(usize, &mut [T]) + Send 
 /// Scans the cells of `rows`, appending overlapping pairs: per circle (in cell order), the rest
 /// of its own cell, then the half stencil's cells. Visiting circles rather than cells skips the
 /// empty cells, which outnumber circles in a sparse gas.
-fn scan_rows<T: Disc>(
+fn scan_rows(
     cells: &CellList,
-    sorted: &[T],
+    sorted: &[Disc],
     space: Space,
     rows: std::ops::Range<usize>,
     pairs: &mut Vec<(u32, u32)>,
@@ -308,9 +281,9 @@ fn scan_rows<T: Disc>(
 }
 
 /// [`scan_rows`] with the displacement function fixed at compile time.
-fn scan_rows_with<T: Disc>(
+fn scan_rows_with(
     cells: &CellList,
-    sorted: &[T],
+    sorted: &[Disc],
     offset: impl Fn(DVec2, DVec2) -> DVec2,
     rows: std::ops::Range<usize>,
     pairs: &mut Vec<(u32, u32)>,
@@ -324,7 +297,7 @@ fn scan_rows_with<T: Disc>(
                 continue;
             }
             let (ranges, len) = if cells.periodic {
-                cells.later_neighbours(x, y)
+                cells.periodic_later_neighbours(x, y)
             } else {
                 // Open grid, written out: own and right cell, then the three cells above.
                 let right = (x + 1).min(cols - 1);
@@ -338,7 +311,7 @@ fn scan_rows_with<T: Disc>(
                 (ranges, 2)
             };
             for k in here.clone() {
-                let (p, r) = (sorted[k].centre(), sorted[k].radius());
+                let (p, r) = sorted[k];
                 for range in &ranges[..len] {
                     // Within its own cell a circle meets only the ones after it.
                     let from = if range.contains(&k) {
@@ -346,9 +319,9 @@ fn scan_rows_with<T: Disc>(
                     } else {
                         range.start
                     };
-                    for (l, other) in sorted[from..range.end].iter().enumerate() {
-                        let reach = r + other.radius();
-                        if offset(p, other.centre()).length_squared() < reach * reach {
+                    for (l, &(q, s)) in sorted[from..range.end].iter().enumerate() {
+                        let reach = r + s;
+                        if offset(p, q).length_squared() < reach * reach {
                             let (k, l) = (k as u32, (from + l) as u32);
                             // Oriented so the first has the lower input index.
                             let lower_first = cells.order[k as usize] < cells.order[l as usize];
@@ -366,11 +339,16 @@ fn scan_rows_with<T: Disc>(
 /// put thousands of small circles in each cell.
 pub const MULTI_LEVEL_RATIO: f64 = 8.0;
 
-/// Whether the radii span more than [`MULTI_LEVEL_RATIO`], so that one grid would be slow.
-pub fn needs_levels<T: Disc>(circles: &[T]) -> bool {
-    let (r_min, r_max) = circles.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
-        (lo.min(c.radius()), hi.max(c.radius()))
-    });
+/// The smallest and largest radius (`(∞, 0)` for no circles), in one pass.
+pub fn radius_range(circles: &[Disc]) -> (f64, f64) {
+    circles.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
+        (lo.min(c.1), hi.max(c.1))
+    })
+}
+
+/// Whether radii from `r_min` to `r_max` span more than [`MULTI_LEVEL_RATIO`], so that one grid
+/// would be slow.
+pub fn needs_levels((r_min, r_max): (f64, f64)) -> bool {
     r_min > 0.0 && r_max > MULTI_LEVEL_RATIO * r_min
 }
 
@@ -399,14 +377,14 @@ pub fn overlapping_pairs(
 pub fn pairs_among(
     cells: &mut CellList,
     space: Space,
-    circles: &[(DVec2, f64)],
+    circles: &[Disc],
     pairs: &mut Vec<(u32, u32)>,
 ) {
-    if needs_levels(circles) {
-        let r_min = circles.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let (r_min, r_max) = radius_range(circles);
+    if needs_levels((r_min, r_max)) {
         multi_level_pairs(space, circles, r_min, pairs);
     } else {
-        single_level_pairs(cells, space, circles, pairs);
+        single_level_pairs(cells, space, circles, r_max, pairs);
     }
 }
 
@@ -414,12 +392,13 @@ pub fn pairs_among(
 fn single_level_pairs(
     cells: &mut CellList,
     space: Space,
-    circles: &[(DVec2, f64)],
+    circles: &[Disc],
+    max_radius: f64,
     pairs: &mut Vec<(u32, u32)>,
 ) {
     let start = pairs.len();
     let mut sorted = std::mem::take(&mut cells.sorted);
-    pairs_in_cell_order(cells, space, circles, &mut sorted, pairs);
+    pairs_in_cell_order(cells, space, circles, max_radius, &mut sorted, pairs);
     cells.sorted = sorted;
     for pair in &mut pairs[start..] {
         *pair = (cells.order[pair.0 as usize], cells.order[pair.1 as usize]);
@@ -452,12 +431,12 @@ fn multi_level_pairs(
         let own: Vec<(DVec2, f64)> = members.iter().map(|&i| circles[i as usize]).collect();
         let mut cells = CellList::default();
         let mut local = Vec::new();
-        single_level_pairs(&mut cells, space, &own, &mut local);
+        let max_radius = radius_range(&own).1;
+        single_level_pairs(&mut cells, space, &own, max_radius, &mut local);
         pairs.extend(local.into_iter().map(|(a, b)| {
             let (i, j) = (members[a as usize], members[b as usize]);
             (i.min(j), i.max(j))
         }));
-        let max_radius = own.iter().map(|c| c.1).fold(0.0f64, f64::max);
         levels.push(Level {
             members,
             cells,
@@ -496,20 +475,20 @@ fn sort_and_dedupe(pairs: &mut Vec<(u32, u32)>, start: usize) {
 }
 
 /// The single-grid broad phase, for circles of similar size (see [`needs_levels`]): buckets
-/// `circles` into `cells` (one largest diameter wide), copies them into `sorted` in cell order
+/// `circles` into `cells` (one largest diameter, `2 · max_radius`, wide), copies them into `sorted` in cell order
 /// ([`CellList::order`]) and appends the overlapping pairs as positions in that order, each
 /// pair's first member being the one with the lower input index.
 ///
 /// Working in cell order keeps the scan, and whatever the caller does with the pairs, on
 /// nearby memory instead of jumping through the circles in input order.
-pub fn pairs_in_cell_order<T: Disc>(
+pub fn pairs_in_cell_order(
     cells: &mut CellList,
     space: Space,
-    circles: &[T],
-    sorted: &mut Vec<T>,
+    circles: &[Disc],
+    max_radius: f64,
+    sorted: &mut Vec<Disc>,
     pairs: &mut Vec<(u32, u32)>,
 ) {
-    let max_radius = circles.iter().map(Disc::radius).fold(0.0f64, f64::max);
     match space {
         Space::Open => cells.rebuild(circles, 2.0 * max_radius),
         Space::Periodic { min, size } => {
@@ -518,14 +497,12 @@ pub fn pairs_in_cell_order<T: Disc>(
     }
     let start = pairs.len();
     sorted.clear();
-    if let Some(&any) = circles.first() {
-        sorted.resize(cells.order.len(), any);
-        map_chunks(sorted, |from, out| {
-            for (slot, &i) in out.iter_mut().zip(&cells.order[from..]) {
-                *slot = circles[i as usize];
-            }
-        });
-    }
+    sorted.resize(cells.order.len(), (DVec2::ZERO, 0.0));
+    map_chunks(sorted, |from, out| {
+        for (slot, &i) in out.iter_mut().zip(&cells.order[from..]) {
+            *slot = circles[i as usize];
+        }
+    });
     if circles.len() >= PARALLEL_FROM {
         // Rows are independent: scan bands of rows on the task pool and append each band's
         // pairs in row order, so the result does not depend on the number of threads.

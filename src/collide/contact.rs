@@ -17,17 +17,6 @@ pub struct Body {
     pub inv_mass: f64,
 }
 
-impl super::broad_phase::Disc for Body {
-    #[inline]
-    fn centre(&self) -> DVec2 {
-        self.position
-    }
-    #[inline]
-    fn radius(&self) -> f64 {
-        self.radius
-    }
-}
-
 /// What [`resolve_contact`] did to a pair.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct ContactOutcome {

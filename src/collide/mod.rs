@@ -14,7 +14,9 @@ use crate::components::{Mass, Position, Radius, Velocity};
 use crate::config::{Arena, Boundary, Effects};
 use crate::diagnostics::CollisionCounters;
 use crate::effects::{Effect, schedule_effect};
-use broad_phase::{CellList, Space, needs_levels, pairs_among, pairs_in_cell_order};
+use broad_phase::{
+    CellList, Disc, Space, needs_levels, pairs_among, pairs_in_cell_order, radius_range,
+};
 use contact::{Body, resolve_contact};
 
 /// Resolves overlaps between circles: separation plus restitution impulse (`effects.restitution`),
@@ -45,11 +47,11 @@ pub fn collision_space(arena: &Arena, boundary: Boundary) -> Space {
 /// and inverse masses apart (read only for the pairs that touch).
 #[derive(Default)]
 pub struct ContactScratch {
-    discs: Vec<(DVec2, f64)>,
+    discs: Vec<Disc>,
     velocities: Vec<DVec2>,
     inv_masses: Vec<f64>,
     /// `discs` in cell order, while contacts are resolved.
-    sorted: Vec<(DVec2, f64)>,
+    sorted: Vec<Disc>,
     /// `0, 1, 2, …`: the order of the multi-level path, which resolves in input order.
     identity: Vec<u32>,
     pairs: Vec<(u32, u32)>,
@@ -80,16 +82,6 @@ impl ContactScratch {
             radius: self.discs[i].1,
             inv_mass: self.inv_masses[i],
         }
-    }
-
-    /// Number of circles.
-    pub fn len(&self) -> usize {
-        self.discs.len()
-    }
-
-    /// Whether there are no circles.
-    pub fn is_empty(&self) -> bool {
-        self.discs.is_empty()
     }
 }
 
@@ -130,14 +122,15 @@ pub fn resolve_all_contacts(
         cells,
     } = scratch;
     pairs.clear();
-    let order: &[u32] = if needs_levels(discs) {
+    let radii = radius_range(discs);
+    let order: &[u32] = if needs_levels(radii) {
         pairs_among(cells, space, discs, pairs);
         sorted.clone_from(discs);
         identity.clear();
         identity.extend(0..discs.len() as u32);
         identity
     } else {
-        pairs_in_cell_order(cells, space, discs, sorted, pairs);
+        pairs_in_cell_order(cells, space, discs, radii.1, sorted, pairs);
         cells.order()
     };
     let mut stats = PassStats::default();
