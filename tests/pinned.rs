@@ -1,0 +1,164 @@
+//! Behaviour pinned bit for bit: the final state of 600 steps of `classic`, `gas1k` and
+//! `billiards` under `discrete`, `substeps=4`, `swept` and `exact`, and the pair-collision counts
+//! of the quick accuracy study. Restructuring the code must not change any of them; a deliberate
+//! change of results updates the table here in the same commit and says why.
+//!
+//! Both go through the command line (`run --dump`, `accuracy --quick`), whose outputs are a
+//! stable contract, so moving code inside the library never needs this file to change.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn moving_circles(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mc-pinned-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// FNV-1a over bytes: defined here, so the pinned values cannot move with a hasher's version.
+fn fnv1a(hash: u64, bytes: &[u8]) -> u64 {
+    bytes.iter().fold(hash, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// A hash of the exact bits of every circle's position and velocity in a particle-format dump,
+/// in the dump's order (which is spawn order).
+fn state_hash(dump: &Path) -> u64 {
+    let text = std::fs::read_to_string(dump).unwrap();
+    let mut hash = 0xcbf2_9ce4_8422_2325;
+    for line in text.lines().skip(1) {
+        for word in line.split_whitespace().take(4) {
+            let x: f64 = word.parse().unwrap();
+            hash = fnv1a(hash, &x.to_bits().to_le_bytes());
+        }
+    }
+    hash
+}
+
+/// `(scene, solver, hash of the state after 600 steps)`, measured on the code before the
+/// restructuring of the module layout.
+const PINNED_STATES: [(&str, &str, u64); 12] = [
+    ("classic", "discrete", 0x70ec138773ba3976),
+    ("classic", "substeps=4", 0x9b10061497aa709f),
+    ("classic", "swept", 0x429940bdc7138c76),
+    ("classic", "exact", 0x37d0e86fe7290cfc),
+    ("gas1k", "discrete", 0x23cf5270c00747ab),
+    ("gas1k", "substeps=4", 0x4fd76996d41ba8e5),
+    ("gas1k", "swept", 0xd9b1215eb31e1129),
+    ("gas1k", "exact", 0x967119e1cc116c38),
+    ("billiards", "discrete", 0x69534087135c38f7),
+    ("billiards", "substeps=4", 0xe84ae06dacd1b120),
+    ("billiards", "swept", 0x0d4c0ac1532d52e2),
+    ("billiards", "exact", 0x6c1e197758c615f5),
+];
+
+#[test]
+fn the_final_states_of_600_steps_are_unchanged_bit_for_bit() {
+    let dir = temp_dir("states");
+    let mut differ = Vec::new();
+    for (scene, solver, expected) in PINNED_STATES {
+        let dump = dir.join(format!("{scene}-{solver}.txt"));
+        let scene_path = format!("assets/scenes/{scene}.ron");
+        moving_circles(&[
+            "run",
+            "--scene",
+            &scene_path,
+            "--solver",
+            solver,
+            "--steps",
+            "600",
+            "--dump",
+            dump.to_str().unwrap(),
+        ]);
+        let hash = state_hash(&dump);
+        println!("(\"{scene}\", \"{solver}\", {hash:#018x}),");
+        if hash != expected {
+            differ.push(format!(
+                "{scene} under {solver}: {hash:#018x}, pinned {expected:#018x}"
+            ));
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(
+        differ.is_empty(),
+        "final states changed:\n{}",
+        differ.join("\n")
+    );
+}
+
+/// `(scene, solver, pair collisions)` of `accuracy --quick` (60 Hz), measured on the code before
+/// the restructuring of the module layout.
+const PINNED_COLLISIONS: [(&str, &str, u64); 28] = [
+    ("gas1k", "discrete", 6813),
+    ("gas1k", "substeps=2", 7152),
+    ("gas1k", "substeps=4", 7367),
+    ("gas1k", "substeps=8", 7480),
+    ("gas1k", "substeps=16", 7495),
+    ("gas1k", "swept", 7484),
+    ("gas1k", "exact", 7484),
+    ("gas", "discrete", 33818),
+    ("gas", "substeps=2", 35887),
+    ("gas", "substeps=4", 36876),
+    ("gas", "substeps=8", 37331),
+    ("gas", "substeps=16", 37411),
+    ("gas", "swept", 37505),
+    ("gas", "exact", 37505),
+    ("billiards", "discrete", 44),
+    ("billiards", "substeps=2", 25),
+    ("billiards", "substeps=4", 22),
+    ("billiards", "substeps=8", 29),
+    ("billiards", "substeps=16", 28),
+    ("billiards", "swept", 30),
+    ("billiards", "exact", 36),
+    ("fast", "discrete", 651),
+    ("fast", "substeps=2", 1210),
+    ("fast", "substeps=4", 2278),
+    ("fast", "substeps=8", 3285),
+    ("fast", "substeps=16", 3606),
+    ("fast", "swept", 3739),
+    ("fast", "exact", 3763),
+];
+
+#[test]
+fn the_accuracy_studys_collision_counts_are_unchanged() {
+    let dir = temp_dir("accuracy");
+    moving_circles(&["accuracy", "--quick", "--out", dir.to_str().unwrap()]);
+    let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|&h| h == name).unwrap();
+    let (scene, solver, count) = (column("scene"), column("solver"), column("pair_collisions"));
+    let measured: Vec<(String, String, u64)> = lines
+        .map(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            (
+                fields[scene].to_owned(),
+                fields[solver].to_owned(),
+                fields[count].parse().unwrap(),
+            )
+        })
+        .collect();
+    for (scene, solver, count) in &measured {
+        println!("(\"{scene}\", \"{solver}\", {count}),");
+    }
+    let pinned: Vec<(String, String, u64)> = PINNED_COLLISIONS
+        .iter()
+        .map(|&(a, b, n)| (a.to_owned(), b.to_owned(), n))
+        .collect();
+    assert_eq!(measured, pinned, "the study's collision counts changed");
+}
