@@ -1,75 +1,65 @@
-//! The arena's edges: walls with the seed's reflection rules in vector form
-//! ([`reflect_off_walls`], a plain function; [`WallsPlugin`]) or periodic wrap-around
-//! ([`wrap_into`]; [`PeriodicPlugin`]), in [`CircleSystems::Boundary`](crate::CircleSystems).
+//! The arena's edges: [`WallsPlugin`], walls with the seed's reflection rule in vector form
+//! ([`reflect_off_walls`], a plain function), or [`PeriodicPlugin`], wrap-around; both in
+//! [`CircleSystems::Boundary`] of the discrete solvers. Wall hits are counted here
+//! ([`WallCollisions`]), by whichever solver makes them.
 //!
 //! Per axis: a circle whose edge is past a wall and that moves outward is mirrored back inside
 //! and its normal velocity flipped; one that is past a wall but already moving inward (pushed
 //! there by a collision) is only put back, so it cannot be flipped twice and stick to the wall.
 
+use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::arena::Arena;
 use crate::components::{Mass, Position, Radius, Velocity};
-use crate::config::{Arena, Effects};
-use crate::diagnostics::CollisionCounters;
-use crate::effects::{Effect, schedule_effect};
+use crate::config::Effects;
+use crate::effects::{Effect, register_effect};
+use crate::schedule::{CircleStep, CircleSystems};
 
-/// Keeps every circle inside the [`Arena`] by reflecting it off the walls.
+/// Keeps every circle inside the [`Arena`] by reflecting it off the walls, when the arena has
+/// walls. (The continuous solvers hit the walls inside their own step.)
 #[derive(Clone, Copy, Debug, Default)]
 pub struct WallsPlugin;
 
 impl Plugin for WallsPlugin {
     fn build(&self, app: &mut App) {
-        schedule_effect(app, Effect::Walls);
+        app.init_resource::<WallCollisions>();
+        register_effect(app, Effect::Walls, &[CircleStep.intern()], || {
+            bounce_off_walls
+                .in_set(CircleSystems::Boundary)
+                .into_configs()
+        });
     }
 }
 
-/// Makes the [`Arena`] periodic: circles leaving one side enter at the opposite one.
+/// Wraps circles leaving one side of a periodic [`Arena`] in at the opposite one.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PeriodicPlugin;
 
 impl Plugin for PeriodicPlugin {
     fn build(&self, app: &mut App) {
-        schedule_effect(app, Effect::Periodic);
+        register_effect(app, Effect::Periodic, &[CircleStep.intern()], || {
+            wrap_around.in_set(CircleSystems::Boundary).into_configs()
+        });
     }
 }
 
-/// `p` moved into `[min, max)` on both axes by whole periods.
-pub fn wrap_into(p: DVec2, arena: &Arena) -> DVec2 {
-    let size = arena.size();
-    let wrapped = arena.min + (p - arena.min).rem_euclid(size);
-    // rem_euclid can round up to exactly `size`; that point is `min` again.
-    DVec2::select(wrapped.cmpge(arena.max), arena.min, wrapped)
-}
-
-/// The shortest displacement from `a` to `b` on a periodic arena of this size (minimum image).
-///
-/// Displacements between wrapped positions are within one box size, which one conditional
-/// shift per axis handles; anything larger falls back to rounding (`round` is a libm call,
-/// and this sits in the innermost loop of the periodic broad phase).
-#[inline]
-pub fn minimum_image(d: DVec2, size: DVec2) -> DVec2 {
-    let half = size * 0.5;
-    let mut r = d;
-    for axis in 0..2 {
-        if r[axis] > half[axis] {
-            r[axis] -= size[axis];
-        } else if r[axis] < -half[axis] {
-            r[axis] += size[axis];
-        }
-        if r[axis].abs() > half[axis] {
-            return d - size * (d / size).round();
-        }
-    }
-    r
+/// Wall hits since the last (re)spawn, under any solver.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct WallCollisions {
+    /// Wall reflections.
+    pub count: u64,
+    /// Momentum the walls took up, `Σ m |Δv|` (for the wall pressure).
+    pub impulse: f64,
 }
 
 /// Wraps every circle's centre back into the arena.
-pub fn wrap_around(arena: Res<Arena>, mut circles: Query<&mut Position>) {
+fn wrap_around(arena: Res<Arena>, mut circles: Query<&mut Position>) {
     let arena = *arena;
     circles.par_iter_mut().for_each(|mut p| {
         if !arena.contains(p.0) || p.0.cmpeq(arena.max).any() {
-            p.0 = wrap_into(p.0, &arena);
+            p.0 = arena.wrap(p.0);
         }
     });
 }
@@ -141,10 +131,10 @@ fn reflect_axis(p: &mut f64, v: &mut f64, lo: f64, hi: f64) -> u32 {
 
 /// Applies [`reflect_off_walls`] to every circle, counts the hits and adds the momentum the
 /// walls took up (`Σ m |Δv|`, for the wall pressure).
-pub fn bounce_off_walls(
+fn bounce_off_walls(
     arena: Res<Arena>,
     effects: Res<Effects>,
-    mut counters: ResMut<CollisionCounters>,
+    mut walls: ResMut<WallCollisions>,
     mut circles: Query<(&mut Position, &mut Velocity, &Radius, &Mass)>,
 ) {
     let mut hits = 0u64;
@@ -161,8 +151,8 @@ pub fn bounce_off_walls(
             hits += u64::from(n);
         }
     }
-    counters.wall_collisions += hits;
-    counters.wall_impulse += impulse;
+    walls.count += hits;
+    walls.impulse += impulse;
 }
 
 #[cfg(test)]
@@ -170,10 +160,7 @@ mod tests {
     use super::*;
 
     fn unit() -> Arena {
-        Arena {
-            min: DVec2::ZERO,
-            max: DVec2::ONE,
-        }
+        Arena::unit_square(crate::arena::Boundary::Walls)
     }
 
     #[test]
@@ -221,25 +208,5 @@ mod tests {
         let (mut p, mut v) = (DVec2::new(1.05, 0.5), DVec2::new(2.0, 1.0));
         reflect_off_walls(&mut p, &mut v, 0.1, &unit(), 0.5);
         assert_eq!(v, DVec2::new(-1.0, 1.0));
-    }
-
-    #[test]
-    fn wrapping_lands_inside_and_minimum_image_is_shortest() {
-        let arena = unit();
-        for p in [
-            DVec2::new(1.2, -0.3),
-            DVec2::new(-1e-9, 1.0),
-            DVec2::new(7.5, 3.25),
-        ] {
-            let w = wrap_into(p, &arena);
-            assert!(
-                w.cmpge(DVec2::ZERO).all() && w.cmplt(DVec2::ONE).all(),
-                "{p} → {w}"
-            );
-        }
-        assert!(
-            (minimum_image(DVec2::new(0.9, -0.8), DVec2::ONE) - DVec2::new(-0.1, 0.2)).length()
-                < 1e-6
-        );
     }
 }

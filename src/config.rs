@@ -1,6 +1,8 @@
-//! Plain configuration structs for the plugin group: the arena, spawning, the solver and the
-//! effects a scene calls for. Each is a `Resource` once the plugins are added, so systems and
-//! users read (and change) the live settings in one place.
+//! Plain configuration structs for the plugin group: spawning, the solver, the effects a scene
+//! calls for, and [`CirclesConfig`] holding them with the [`Arena`]. Each is a `Resource` once
+//! the plugins are added, so systems and users read (and change) the live settings in one
+//! place. Each has one `check`, used by scene files, the command line and spawning alike, and
+//! the limits they check against are the constants here.
 
 use std::fmt;
 use std::str::FromStr;
@@ -9,53 +11,21 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// The axis-aligned rectangle the circles live in, bounded by walls.
-#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[reflect(Resource, Debug)]
-pub struct Arena {
-    /// Lower-left corner.
-    pub min: DVec2,
-    /// Upper-right corner.
-    pub max: DVec2,
-}
+use crate::arena::Arena;
+use crate::circle::CircleState;
+use crate::error::FieldError;
 
-impl Default for Arena {
-    /// A 16:9 arena, 16 units wide, centred on the origin (the seed's window shape).
-    fn default() -> Self {
-        Self::centered(DVec2::new(16.0, 9.0))
-    }
-}
-
-impl Arena {
-    /// An arena of the given size centred on the origin.
-    pub fn centered(size: DVec2) -> Self {
-        Self {
-            min: -size / 2.0,
-            max: size / 2.0,
-        }
-    }
-
-    /// Width and height.
-    pub fn size(&self) -> DVec2 {
-        self.max - self.min
-    }
-
-    /// Area of the arena.
-    pub fn area(&self) -> f64 {
-        let s = self.size();
-        s.x * s.y
-    }
-
-    /// Centre of the arena.
-    pub fn center(&self) -> DVec2 {
-        (self.min + self.max) / 2.0
-    }
-
-    /// Whether a point lies inside or on the boundary.
-    pub fn contains(&self, p: DVec2) -> bool {
-        p.cmpge(self.min).all() && p.cmple(self.max).all()
-    }
-}
+/// Most circles any input may ask for: random spawns and particle files alike. Checked before
+/// anything is allocated, so a file claiming 10¹¹ circles fails at once.
+pub const MAX_CIRCLES: usize = 20_000_000;
+/// Smallest and largest fixed step in seconds: below 1 ns the fixed clock (nanoseconds) cannot
+/// represent it; above a minute nothing sensible is being simulated.
+pub const DT_RANGE: (f64, f64) = (1e-9, 60.0);
+/// Most substeps `substeps=N` may ask for.
+pub const MAX_SUBSTEPS: u32 = 1024;
+/// Densest area fraction random placement is asked for (0.907 is the densest packing of equal
+/// disks; placement by rejection stalls long before it).
+pub const MAX_AREA_FRACTION: f64 = 0.9;
 
 /// How a spawned circle's mass is chosen.
 #[derive(Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -82,6 +52,23 @@ impl MassModel {
         match self {
             Self::Area { density } => density * std::f64::consts::PI * r * r,
             Self::Equal(m) => m,
+        }
+    }
+
+    /// Whether masses from this model are positive and finite.
+    pub fn check(self) -> Result<(), FieldError> {
+        match self {
+            Self::Area { density } if !(density.is_finite() && density > 0.0) => {
+                Err(FieldError::new(
+                    "mass",
+                    format!("Area density must be positive and finite, got {density}"),
+                ))
+            }
+            Self::Equal(m) if !(m.is_finite() && m > 0.0) => Err(FieldError::new(
+                "mass",
+                format!("Equal mass must be positive and finite, got {m}"),
+            )),
+            _ => Ok(()),
         }
     }
 }
@@ -138,6 +125,47 @@ impl SpawnConfig {
             0
         }
     }
+
+    /// Whether these rules can place circles in `arena`: ranges ordered, finite and positive
+    /// where they must be, and no more than [`MAX_CIRCLES`] asked for. Fields are named
+    /// relative to the spawn rules (`radius`, `count`, …).
+    pub fn check(&self, arena: &Arena) -> Result<(), FieldError> {
+        let (r0, r1) = self.radius;
+        if !(r0.is_finite() && r1.is_finite() && r0 > 0.0 && r0 <= r1) {
+            return Err(FieldError::new(
+                "radius",
+                format!("must be (min, max) with 0 < min <= max, got ({r0}, {r1})"),
+            ));
+        }
+        let (s0, s1) = self.speed;
+        if !(s0.is_finite() && s1.is_finite() && s0 >= 0.0 && s0 <= s1) {
+            return Err(FieldError::new(
+                "speed",
+                format!("must be (min, max) with 0 <= min <= max, got ({s0}, {s1})"),
+            ));
+        }
+        if let Some(phi) = self.area_fraction
+            && !(phi.is_finite() && phi > 0.0 && phi <= MAX_AREA_FRACTION)
+        {
+            return Err(FieldError::new(
+                "area_fraction",
+                format!(
+                    "must be in (0, {MAX_AREA_FRACTION}] (0.907 is the densest packing), got {phi}"
+                ),
+            ));
+        }
+        let n = self.target_count(arena);
+        if n > MAX_CIRCLES {
+            return Err(FieldError::new(
+                "count",
+                format!("asks for {n} circles; at most {MAX_CIRCLES} are supported"),
+            ));
+        }
+        if self.attempts_per_circle == 0 {
+            return Err(FieldError::new("attempts_per_circle", "must be at least 1"));
+        }
+        Ok(())
+    }
 }
 
 /// How one fixed step of simulated time is advanced.
@@ -185,7 +213,8 @@ impl fmt::Display for Solver {
 /// Why a solver name could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
-    "unknown solver `{0}`: expected `discrete`, `substeps=N` (N from 1 to 1024), `swept` or `exact`"
+    "unknown solver `{0}`: expected `discrete`, `substeps=N` (N from 1 to {max}), `swept` or `exact`",
+    max = MAX_SUBSTEPS
 )]
 pub struct ParseSolverError(pub String);
 
@@ -201,7 +230,7 @@ impl FromStr for Solver {
             other => {
                 let n = other.strip_prefix("substeps=").ok_or_else(err)?;
                 match n.parse::<u32>() {
-                    Ok(n @ 1..=1024) => Ok(Self::Substeps(n)),
+                    Ok(n) if (1..=MAX_SUBSTEPS).contains(&n) => Ok(Self::Substeps(n)),
                     _ => Err(err()),
                 }
             }
@@ -222,42 +251,12 @@ impl<'de> Deserialize<'de> for Solver {
     }
 }
 
-/// What happens at the edges of the arena.
-#[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Boundary {
-    /// Solid walls: circles bounce off them.
-    #[default]
-    Walls,
-    /// Periodic: a circle leaving one side enters at the opposite one, and circles interact
-    /// across the seam (minimum image).
-    Periodic,
-}
-
-impl FromStr for Boundary {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "walls" => Ok(Self::Walls),
-            "periodic" => Ok(Self::Periodic),
-            other => Err(format!(
-                "unknown boundary `{other}`: expected `walls` or `periodic`"
-            )),
-        }
-    }
-}
-
 /// The effects a scene calls for. Only these get systems in the schedule: no gravity, no
 /// gravity system; no collisions, no broad phase.
 #[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[reflect(Resource, Debug)]
 #[serde(default, deny_unknown_fields)]
 pub struct Effects {
-    /// Walls or periodic edges. Not read from a scene's `effects` (a scene sets it as
-    /// `arena.boundary`), so writing it there is an unknown-field error, not silently ignored.
-    #[serde(skip)]
-    pub boundary: Boundary,
     /// Circle-circle collisions (broad phase, separation and impulse).
     pub collisions: bool,
     /// Constant acceleration, e.g. `(0, -9.81)`; `None` schedules no gravity system.
@@ -273,7 +272,6 @@ pub struct Effects {
 impl Default for Effects {
     fn default() -> Self {
         Self {
-            boundary: Boundary::Walls,
             collisions: true,
             gravity: None,
             drag: None,
@@ -283,11 +281,48 @@ impl Default for Effects {
     }
 }
 
+impl Effects {
+    /// Whether every parameter is usable: restitutions in `[0, 1]`, finite gravity, a finite
+    /// non-negative drag rate.
+    pub fn check(&self) -> Result<(), FieldError> {
+        let unit = |x: f64| x.is_finite() && (0.0..=1.0).contains(&x);
+        if !unit(self.restitution) {
+            return Err(FieldError::new(
+                "effects.restitution",
+                format!("must be in [0, 1], got {}", self.restitution),
+            ));
+        }
+        if !unit(self.wall_restitution) {
+            return Err(FieldError::new(
+                "effects.wall_restitution",
+                format!("must be in [0, 1], got {}", self.wall_restitution),
+            ));
+        }
+        if let Some(g) = self.gravity
+            && !g.is_finite()
+        {
+            return Err(FieldError::new(
+                "effects.gravity",
+                format!("must be finite, got {g}"),
+            ));
+        }
+        if let Some(drag) = self.drag
+            && !(drag.is_finite() && drag >= 0.0)
+        {
+            return Err(FieldError::new(
+                "effects.drag",
+                format!("must be a finite rate >= 0 (1/s), got {drag}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Everything [`CirclesPlugins`](crate::CirclesPlugins) needs, in one value. Scene files
 /// ([`crate::scene`]) are read into this.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CirclesConfig {
-    /// The walls.
+    /// The arena and its edges.
     pub arena: Arena,
     /// Random initial circles.
     pub spawn: SpawnConfig,
@@ -298,7 +333,7 @@ pub struct CirclesConfig {
     /// The fixed step in seconds.
     pub dt: f64,
     /// Circles placed exactly as given, before the random ones.
-    pub circles: Vec<crate::spawn::CircleInit>,
+    pub circles: Vec<CircleState>,
 }
 
 impl Default for CirclesConfig {
@@ -312,6 +347,28 @@ impl Default for CirclesConfig {
             dt: 1.0 / 60.0,
             circles: Vec::new(),
         }
+    }
+}
+
+impl CirclesConfig {
+    /// Whether the settings can be simulated: a usable arena and step, usable effects, mass
+    /// model and spawn rules. (Explicit circles are checked where they are read, since only the
+    /// file knows where each came from.)
+    pub fn check(&self) -> Result<(), FieldError> {
+        let (dt_min, dt_max) = DT_RANGE;
+        if !(self.dt.is_finite() && self.dt >= dt_min && self.dt <= dt_max) {
+            return Err(FieldError::new(
+                "dt",
+                format!(
+                    "must be between {dt_min} and {dt_max} seconds, got {}",
+                    self.dt
+                ),
+            ));
+        }
+        self.arena.check()?;
+        self.effects.check()?;
+        self.spawn.mass.check()?;
+        self.spawn.check(&self.arena).map_err(|e| e.within("spawn"))
     }
 }
 

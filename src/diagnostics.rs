@@ -1,90 +1,19 @@
-//! What the simulation measures about itself: collision counters the step systems fill in, and
-//! [`CircleDiagnostics`] (energy, momentum, drift since the last reset), computed after each
-//! fixed step in [`CircleSystems::Diagnostics`] and read by the HUD and the reports.
+//! What the simulation measures about itself after each fixed step, in
+//! [`CircleSystems::Diagnostics`]: [`CircleDiagnostics`] (energy, momentum, drift since the
+//! last reset) from plain [`Totals`], and [`Pressure`] from the collision counters their owners
+//! keep (`PairCollisions` in `collide`, `WallCollisions` in `boundary`) and the schedule's
+//! [`StepTotals`]. After a (re)spawn it takes the new baseline and zeroes those counters.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::collide::broad_phase::{CellList, Space, overlapping_pairs};
+use crate::arena::Arena;
+use crate::boundary::WallCollisions;
+use crate::collide::PairCollisions;
 use crate::components::{Mass, Position, Radius, Velocity};
-use crate::config::{Arena, Effects};
-use crate::schedule::CircleSystems;
-use crate::spawn::CircleInit;
+use crate::config::Effects;
+use crate::schedule::{CircleSystems, StepTotals};
 use crate::spawn::SpawnReport;
-
-/// Running totals since the last (re)spawn, written by the step systems.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
-pub struct CollisionCounters {
-    /// Fixed steps advanced.
-    pub steps: u64,
-    /// Simulated seconds advanced.
-    pub sim_seconds: f64,
-    /// Circle-circle impulses applied.
-    pub pair_collisions: u64,
-    /// Wall reflections.
-    pub wall_collisions: u64,
-    /// Momentum the walls took up, `Σ m |Δv|` over wall hits.
-    pub wall_impulse: f64,
-    /// Collisional virial `Σ (r_a + r_b) · j` over circle-circle impulses.
-    pub virial: f64,
-}
-
-impl CollisionCounters {
-    /// Adds one collision pass.
-    pub fn record_pass(&mut self, pass: &crate::collide::PassStats) {
-        self.pair_collisions += pass.collisions;
-        self.virial += pass.virial;
-    }
-}
-
-/// Overlaps in a state, each as a fraction of the pair's smaller radius.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Overlaps {
-    /// Overlapping pairs.
-    pub pairs: usize,
-    /// Deepest overlap.
-    pub max: f64,
-    /// Sum of the overlaps (for a mean over pairs).
-    pub sum: f64,
-}
-
-/// Every overlapping pair `(i, j, depth)` of `circles` (`i < j`, sorted), with `depth` the
-/// overlap distance `r_i + r_j − |x_j − x_i|` in `space` (broad phase, so O(N)).
-pub fn overlapping_circles(circles: &[CircleInit], space: Space) -> Vec<(usize, usize, f64)> {
-    let positions: Vec<DVec2> = circles.iter().map(|c| c.position).collect();
-    let radii: Vec<f64> = circles.iter().map(|c| c.radius).collect();
-    let mut pairs = Vec::new();
-    overlapping_pairs(
-        &mut CellList::default(),
-        space,
-        &positions,
-        &radii,
-        &mut pairs,
-    );
-    pairs.sort_unstable();
-    pairs
-        .into_iter()
-        .map(|(i, j)| {
-            let (i, j) = (i as usize, j as usize);
-            let depth = radii[i] + radii[j] - space.offset(positions[i], positions[j]).length();
-            (i, j, depth)
-        })
-        .collect()
-}
-
-impl Overlaps {
-    /// Measures the overlaps of `circles` in `space`.
-    pub fn measure(circles: &[CircleInit], space: Space) -> Self {
-        let mut overlaps = Self::default();
-        for (i, j, depth) in overlapping_circles(circles, space) {
-            let fraction = depth / circles[i].radius.min(circles[j].radius);
-            overlaps.pairs += 1;
-            overlaps.max = overlaps.max.max(fraction);
-            overlaps.sum += fraction;
-        }
-        overlaps
-    }
-}
 
 /// Pressure as the compressibility factor `z = P·A / (N·kT)`, with `kT` the mean kinetic energy
 /// per circle (2D), measured two ways over the time since the last reset.
@@ -99,15 +28,17 @@ pub struct Pressure {
 
 impl Pressure {
     /// Pressure of `n` circles with total kinetic energy `kinetic_energy` in `arena`, from the
-    /// counters. `None` where it is undefined (no time, no circles, no motion, or no walls).
+    /// counters over `elapsed`. `None` where it is undefined (no time, no circles, no motion,
+    /// or no walls).
     pub fn measure(
-        counters: &CollisionCounters,
+        elapsed: &StepTotals,
+        pairs: &PairCollisions,
+        walls: &WallCollisions,
         n: usize,
         kinetic_energy: f64,
-        arena: &crate::config::Arena,
-        walls: bool,
+        arena: &Arena,
     ) -> Self {
-        let t = counters.sim_seconds;
+        let t = elapsed.sim_seconds;
         let n_kt = kinetic_energy; // N·kT = total kinetic energy in 2D
         if !(t > 0.0 && n > 0 && n_kt > 0.0) {
             return Self::default();
@@ -116,8 +47,8 @@ impl Pressure {
         let area = size.x * size.y;
         let perimeter = 2.0 * (size.x + size.y);
         Self {
-            z_virial: Some(1.0 + counters.virial / (2.0 * t * n_kt)),
-            z_wall: walls.then(|| counters.wall_impulse / (t * perimeter) * area / n_kt),
+            z_virial: Some(1.0 + pairs.virial / (2.0 * t * n_kt)),
+            z_wall: (!arena.is_periodic()).then(|| walls.impulse / (t * perimeter) * area / n_kt),
         }
     }
 }
@@ -215,31 +146,33 @@ impl Totals {
     }
 }
 
-/// Measures energy and momentum after every fixed step.
+/// Measures energy and momentum after every fixed step, and takes the baseline after every
+/// (re)spawn.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct DiagnosticsPlugin;
 
 impl Plugin for DiagnosticsPlugin {
     fn build(&self, app: &mut App) {
+        let measured = || (measure, take_baseline).chain();
         app.init_resource::<CircleDiagnostics>()
-            .add_systems(Startup, measure.after(CircleSystems::Spawn))
+            .init_resource::<PairCollisions>()
+            .init_resource::<WallCollisions>()
+            .add_systems(Startup, measured().after(CircleSystems::Spawn))
             .add_systems(
                 PreUpdate,
-                measure
+                measured()
                     .after(CircleSystems::Spawn)
                     .run_if(resource_changed::<SpawnReport>),
             )
-            .add_systems(FixedUpdate, measure.in_set(CircleSystems::Diagnostics));
+            .add_systems(FixedUpdate, measured().in_set(CircleSystems::Diagnostics));
     }
 }
 
-/// Updates [`CircleDiagnostics`]; after a (re)spawn, takes the new baseline and zeroes counters.
-pub fn measure(
-    report: Res<SpawnReport>,
+/// Updates [`CircleDiagnostics`] from the circles.
+fn measure(
     arena: Res<Arena>,
     effects: Res<Effects>,
     mut diagnostics: ResMut<CircleDiagnostics>,
-    mut counters: ResMut<CollisionCounters>,
     circles: Query<(&Position, &Velocity, &Mass), With<Radius>>,
 ) {
     let totals = Totals::measure(
@@ -253,9 +186,21 @@ pub fn measure(
     diagnostics.momentum = totals.momentum;
     diagnostics.non_finite = totals.non_finite;
     diagnostics.escaped = totals.escaped;
+}
+
+/// After a (re)spawn: the energy now is the new baseline, and every counter starts again.
+fn take_baseline(
+    report: Res<SpawnReport>,
+    mut diagnostics: ResMut<CircleDiagnostics>,
+    mut elapsed: ResMut<StepTotals>,
+    mut pairs: ResMut<PairCollisions>,
+    mut walls: ResMut<WallCollisions>,
+) {
     if diagnostics.generation != report.generation {
         diagnostics.generation = report.generation;
-        diagnostics.initial_energy = totals.energy();
-        *counters = CollisionCounters::default();
+        diagnostics.initial_energy = diagnostics.energy;
+        *elapsed = StepTotals::default();
+        *pairs = PairCollisions::default();
+        *walls = WallCollisions::default();
     }
 }

@@ -1,19 +1,19 @@
-//! The effects a scene can call for, each owning a system set in the [`CircleStep`] schedule,
-//! so that exactly the called-for effects have systems — at startup (through the plugins) and
-//! after a scene is hot-reloaded ([`reconcile_effects`] adds and removes systems).
-//! Also the two force effects themselves: gravity and linear drag.
+//! The effects a scene can call for, and the registry that keeps exactly those in the schedule.
+//!
+//! Each effect's plugin (gravity and drag in `forces`, walls and periodic edges in `boundary`,
+//! collisions in `collide`) owns its systems and hands a recipe for them to
+//! [`register_effect`]. The recipe is used at once if the configuration calls for the effect,
+//! and again by [`reconcile_effects`] when a reloaded scene switches the effect on; switching it
+//! off removes its systems. This module names no system, so it imports none.
 
 use bevy::ecs::intern::Interned;
 use bevy::ecs::schedule::{ScheduleCleanupPolicy, ScheduleConfigs, ScheduleLabel};
 use bevy::ecs::system::ScheduleSystem;
-use bevy::platform::collections::HashSet;
+use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 
-use crate::boundary::{bounce_off_walls, wrap_around};
-use crate::collide::collide_circles;
-use crate::components::Velocity;
-use crate::config::{Boundary, Effects};
-use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepDt};
+use crate::arena::{Arena, Boundary};
+use crate::config::Effects;
 
 /// One schedulable effect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -44,90 +44,131 @@ impl Effect {
         Effect::Collisions,
     ];
 
-    /// The effects `effects` calls for.
-    pub fn called_for(effects: &Effects) -> Vec<Effect> {
+    /// Whether `effects` on an arena with this `boundary` calls for this effect.
+    pub fn is_called_for(self, effects: &Effects, boundary: Boundary) -> bool {
+        match self {
+            Effect::Gravity => effects.gravity.is_some(),
+            Effect::Drag => effects.drag.is_some(),
+            Effect::Walls => boundary == Boundary::Walls,
+            Effect::Periodic => boundary == Boundary::Periodic,
+            Effect::Collisions => effects.collisions,
+        }
+    }
+
+    /// The effects `effects` on an arena with this `boundary` calls for, in schedule order.
+    ///
+    /// ```
+    /// use moving_circles::prelude::*;
+    ///
+    /// let effects = Effects { collisions: false, ..Effects::default() };
+    /// assert_eq!(Effect::called_for(&effects, Boundary::Walls), [Effect::Walls]);
+    /// ```
+    pub fn called_for(effects: &Effects, boundary: Boundary) -> Vec<Effect> {
         Self::ALL
             .into_iter()
-            .filter(|e| match e {
-                Effect::Gravity => effects.gravity.is_some(),
-                Effect::Drag => effects.drag.is_some(),
-                Effect::Walls => effects.boundary == Boundary::Walls,
-                Effect::Periodic => effects.boundary == Boundary::Periodic,
-                Effect::Collisions => effects.collisions,
-            })
+            .filter(|e| e.is_called_for(effects, boundary))
             .collect()
     }
 
-    /// The schedules this effect has systems in: forces act under every solver; walls,
-    /// periodic edges and collisions are the discrete solvers' (the continuous solvers handle
-    /// them inside their own step).
-    pub fn schedules(self) -> &'static [Interned<dyn ScheduleLabel>] {
-        static BOTH: std::sync::LazyLock<[Interned<dyn ScheduleLabel>; 2]> =
-            std::sync::LazyLock::new(|| [CircleStep.intern(), ContinuousStep.intern()]);
-        static DISCRETE: std::sync::LazyLock<[Interned<dyn ScheduleLabel>; 1]> =
-            std::sync::LazyLock::new(|| [CircleStep.intern()]);
+    /// Lower-case name, as reports list it.
+    pub fn name(self) -> &'static str {
         match self {
-            Effect::Gravity | Effect::Drag => &*BOTH,
-            _ => &*DISCRETE,
-        }
-    }
-
-    /// This effect's systems, configured into their sets.
-    pub fn systems(self) -> ScheduleConfigs<ScheduleSystem> {
-        let set = EffectSystems(self);
-        match self {
-            // Forces change velocity before the move (semi-implicit Euler); gravity first.
-            Effect::Gravity => apply_gravity
-                .in_set(set)
-                .in_set(CircleSystems::Forces)
-                .into_configs(),
-            Effect::Drag => apply_drag
-                .in_set(set)
-                .in_set(CircleSystems::Forces)
-                .after(EffectSystems(Effect::Gravity))
-                .into_configs(),
-            Effect::Walls => bounce_off_walls
-                .in_set(set)
-                .in_set(CircleSystems::Boundary)
-                .into_configs(),
-            Effect::Periodic => wrap_around
-                .in_set(set)
-                .in_set(CircleSystems::Boundary)
-                .into_configs(),
-            Effect::Collisions => collide_circles
-                .in_set(set)
-                .in_set(CircleSystems::Collide)
-                .into_configs(),
+            Effect::Gravity => "gravity",
+            Effect::Drag => "drag",
+            Effect::Walls => "walls",
+            Effect::Periodic => "periodic",
+            Effect::Collisions => "collisions",
         }
     }
 }
 
-/// The effects whose systems are in the schedule right now.
-#[derive(Resource, Clone, Debug, Default, PartialEq, Eq)]
-pub struct ScheduledEffects(pub HashSet<Effect>);
+/// Makes an effect's systems, already placed in their sets (the registry adds
+/// [`EffectSystems`]).
+pub type SystemsRecipe = fn() -> ScheduleConfigs<ScheduleSystem>;
 
-/// Adds `effect`'s systems to an app being built (what the effect plugins call).
-pub fn schedule_effect(app: &mut App, effect: Effect) {
-    app.init_resource::<ScheduledEffects>();
-    if app
-        .world_mut()
-        .resource_mut::<ScheduledEffects>()
-        .0
-        .insert(effect)
-    {
-        app.add_systems(CircleStep, effect.systems());
+#[derive(Clone, Debug)]
+struct Recipe {
+    schedules: Vec<Interned<dyn ScheduleLabel>>,
+    systems: SystemsRecipe,
+}
+
+/// The effects whose plugins are present (each with the recipe of its systems), and the ones
+/// whose systems are in the schedule right now.
+#[derive(Resource, Default)]
+pub struct EffectRegistry {
+    recipes: HashMap<Effect, Recipe>,
+    scheduled: HashSet<Effect>,
+}
+
+impl EffectRegistry {
+    /// Whether `effect`'s systems are in the schedule.
+    pub fn is_scheduled(&self, effect: Effect) -> bool {
+        self.scheduled.contains(&effect)
+    }
+
+    /// Whether `effect`'s plugin registered it (a disabled plugin never schedules anything).
+    pub fn is_registered(&self, effect: Effect) -> bool {
+        self.recipes.contains_key(&effect)
     }
 }
 
-/// Makes the schedule hold exactly the systems of the effects `effects` calls for: adds the
-/// missing ones and removes the rest. Used when a scene is reloaded while running.
-pub fn reconcile_effects(world: &mut World, effects: &Effects) {
-    let wanted: HashSet<Effect> = Effect::called_for(effects).into_iter().collect();
-    let scheduled = world.get_resource_or_init::<ScheduledEffects>().0.clone();
-    for label in [CircleStep.intern(), ContinuousStep.intern()] {
+/// Registers `effect`'s systems, made by `systems`, for `schedules`; adds them now if the app's
+/// [`Effects`] and [`Arena`] call for the effect. What an effect plugin calls from `build`.
+pub fn register_effect(
+    app: &mut App,
+    effect: Effect,
+    schedules: &[Interned<dyn ScheduleLabel>],
+    systems: SystemsRecipe,
+) {
+    let world = app.world();
+    let called_for = world
+        .get_resource::<Effects>()
+        .zip(world.get_resource::<Arena>())
+        .is_some_and(|(effects, arena)| effect.is_called_for(effects, arena.boundary));
+    if called_for {
+        for &label in schedules {
+            app.add_systems(label, systems().in_set(EffectSystems(effect)));
+        }
+    }
+    let mut registry = app.world_mut().get_resource_or_init::<EffectRegistry>();
+    registry.recipes.insert(
+        effect,
+        Recipe {
+            schedules: schedules.to_vec(),
+            systems,
+        },
+    );
+    if called_for {
+        registry.scheduled.insert(effect);
+    }
+}
+
+/// Makes the schedules hold exactly the systems of the registered effects that the world's
+/// [`Effects`] and [`Arena`] call for: adds the missing ones and removes the rest. Used when a
+/// scene is reloaded while running.
+pub fn reconcile_effects(world: &mut World) {
+    let effects = *world.resource::<Effects>();
+    let boundary = world.resource::<Arena>().boundary;
+    let registry = world.get_resource_or_init::<EffectRegistry>();
+    let recipes = registry.recipes.clone();
+    let scheduled = registry.scheduled.clone();
+    let wanted: HashSet<Effect> = recipes
+        .keys()
+        .copied()
+        .filter(|e| e.is_called_for(&effects, boundary))
+        .collect();
+    let mut labels: Vec<Interned<dyn ScheduleLabel>> = Vec::new();
+    for recipe in recipes.values() {
+        for label in &recipe.schedules {
+            if !labels.contains(label) {
+                labels.push(*label);
+            }
+        }
+    }
+    for label in labels {
         world.schedule_scope(label, |world, schedule| {
             for &effect in scheduled.difference(&wanted) {
-                if !effect.schedules().contains(&label) {
+                if !recipes[&effect].schedules.contains(&label) {
                     continue;
                 }
                 if let Err(e) = schedule.remove_systems_in_set(
@@ -139,46 +180,12 @@ pub fn reconcile_effects(world: &mut World, effects: &Effects) {
                 }
             }
             for &effect in wanted.difference(&scheduled) {
-                if effect.schedules().contains(&label) {
-                    schedule.add_systems(effect.systems());
+                let recipe = &recipes[&effect];
+                if recipe.schedules.contains(&label) {
+                    schedule.add_systems((recipe.systems)().in_set(EffectSystems(effect)));
                 }
             }
         });
     }
-    world.resource_mut::<ScheduledEffects>().0 = wanted;
-}
-
-/// Adds gravity (`effects.gravity`) to the schedule.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct GravityPlugin;
-
-impl Plugin for GravityPlugin {
-    fn build(&self, app: &mut App) {
-        schedule_effect(app, Effect::Gravity);
-    }
-}
-
-/// Adds linear drag (`effects.drag`) to the schedule.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct DragPlugin;
-
-impl Plugin for DragPlugin {
-    fn build(&self, app: &mut App) {
-        schedule_effect(app, Effect::Drag);
-    }
-}
-
-/// `v += g·dt` for every circle.
-pub fn apply_gravity(effects: Res<Effects>, dt: Res<StepDt>, mut circles: Query<&mut Velocity>) {
-    let Some(g) = effects.gravity else { return };
-    let dv = g * dt.0;
-    circles.par_iter_mut().for_each(|mut v| v.0 += dv);
-}
-
-/// `v *= exp(-drag·dt)`: the exact solution of `v' = -drag·v` over the step, so it can never
-/// overshoot and reverse a velocity however large `dt` is.
-pub fn apply_drag(effects: Res<Effects>, dt: Res<StepDt>, mut circles: Query<&mut Velocity>) {
-    let Some(drag) = effects.drag else { return };
-    let factor = (-drag * dt.0).exp();
-    circles.par_iter_mut().for_each(|mut v| v.0 *= factor);
+    world.resource_mut::<EffectRegistry>().scheduled = wanted;
 }

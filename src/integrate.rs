@@ -21,7 +21,7 @@ impl Plugin for IntegratePlugin {
 }
 
 /// `x += v·dt` for every circle. Each circle is independent, so this runs in parallel.
-pub fn integrate_positions(dt: Res<StepDt>, mut circles: Query<(&mut Position, &Velocity)>) {
+fn integrate_positions(dt: Res<StepDt>, mut circles: Query<(&mut Position, &Velocity)>) {
     let dt = dt.0;
     circles.par_iter_mut().for_each(|(mut position, velocity)| {
         position.0 += velocity.0 * dt;

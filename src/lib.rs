@@ -1,46 +1,22 @@
-//! # moving_circles
-//!
-//! Moving, colliding circles on Bevy 0.19, built the ECS way: circles are entities with
-//! [`Position`], [`Velocity`], [`Radius`] and [`Mass`]; small plugins each own one concern
-//! (spawning, integration, walls, collisions, diagnostics) and [`CirclesPlugins`] composes
-//! only the ones a configuration calls for.
-//!
-//! ```no_run
-//! use bevy::prelude::*;
-//! use moving_circles::prelude::*;
-//!
-//! App::new()
-//!     .add_plugins(MinimalPlugins)
-//!     .add_plugins(CirclesPlugins::new(CirclesConfig {
-//!         spawn: SpawnConfig { count: 500, ..default() },
-//!         ..default()
-//!     }))
-//!     .run();
-//! ```
-//!
-//! Module map (data flows top to bottom every fixed step):
-//! - [`components`]: what a circle is made of.
-//! - [`config`]: plain settings structs (arena, spawn, solver, effects).
-//! - [`schedule`]: the [`CircleSystems`] sets, the [`CircleStep`](schedule::CircleStep) substep
-//!   schedule and the core [`StepPlugin`].
-//! - [`spawn`]: seeded non-overlapping placement.
-//! - [`integrate`]: `x += v·dt`.
-//! - [`boundary`]: wall reflection.
-//! - [`collide`]: broad phase (cell list), contact kernel, the collision system (`discrete`).
-//! - [`exact`]: the event-driven engine behind the `swept` and `exact` solvers.
-//! - [`diagnostics`]: energy, momentum, collision counters.
-//! - `render` (feature `render`): window, drawing, HUD, input, screenshots.
+#![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
 pub mod accuracy;
+pub mod arena;
 pub mod boundary;
+pub mod circle;
 pub mod collide;
+pub mod commands;
 pub mod components;
 pub mod config;
 pub mod diagnostics;
 pub mod effects;
+pub mod error;
 pub mod exact;
+pub mod forces;
+pub mod grid;
 pub mod integrate;
+pub mod io;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod run;
@@ -54,39 +30,43 @@ use boundary::{PeriodicPlugin, WallsPlugin};
 use collide::CollidePlugin;
 use config::CirclesConfig;
 use diagnostics::DiagnosticsPlugin;
-use effects::{DragPlugin, Effect, GravityPlugin};
 use exact::ContinuousPlugin;
+use forces::{DragPlugin, GravityPlugin};
 use integrate::IntegratePlugin;
 use schedule::StepPlugin;
 use spawn::SpawnPlugin;
 
-/// The common imports: components, config, plugins and system sets.
+/// The common imports: the plugin group and its parts, components, configuration, sets and
+/// what the simulation measures.
 pub mod prelude {
     pub use crate::CirclesPlugins;
-    pub use crate::boundary::{PeriodicPlugin, WallsPlugin};
-    pub use crate::collide::CollidePlugin;
+    pub use crate::arena::{Arena, Boundary};
+    pub use crate::boundary::{PeriodicPlugin, WallCollisions, WallsPlugin};
+    pub use crate::circle::CircleState;
+    pub use crate::collide::{CollidePlugin, PairCollisions};
     pub use crate::components::{Mass, Position, Radius, Tint, Velocity};
-    pub use crate::config::{
-        Arena, Boundary, CirclesConfig, Effects, MassModel, Solver, SpawnConfig,
-    };
-    pub use crate::diagnostics::{CircleDiagnostics, CollisionCounters, DiagnosticsPlugin};
-    pub use crate::effects::{DragPlugin, Effect, GravityPlugin};
+    pub use crate::config::{CirclesConfig, Effects, MassModel, Solver, SpawnConfig};
+    pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin};
+    pub use crate::effects::Effect;
     pub use crate::exact::ContinuousPlugin;
+    pub use crate::forces::{DragPlugin, GravityPlugin};
     pub use crate::integrate::IntegratePlugin;
     pub use crate::scene::Scene;
-    pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin};
+    pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
 }
 
 pub use components::{Mass, Position, Radius, Tint, Velocity};
 pub use schedule::CircleSystems;
 
-/// The simulation as a plugin group: [`StepPlugin`], [`SpawnPlugin`], [`IntegratePlugin`],
-/// [`DiagnosticsPlugin`], and one plugin per effect the configuration calls for:
-/// [`GravityPlugin`], [`DragPlugin`], [`WallsPlugin`] or [`PeriodicPlugin`], [`CollidePlugin`].
+/// The simulation as a plugin group: [`StepPlugin`] (first: the others build on it),
+/// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
+/// [`DragPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
+/// [`ContinuousPlugin`] (the `swept` and `exact` solvers) and [`DiagnosticsPlugin`].
 ///
-/// Effects a configuration does not call for are not added at all, so they cost nothing.
-/// Parts can be switched off or replaced the Bevy way:
+/// An effect plugin schedules its systems only when the configuration calls for the effect,
+/// so an effect a scene does not ask for costs nothing; it stays registered, so a reloaded
+/// scene that asks for it gets its systems. Parts can be switched off or replaced the Bevy way:
 ///
 /// ```no_run
 /// # use bevy::prelude::*;
@@ -119,7 +99,7 @@ impl PluginGroup for CirclesPlugins {
             dt,
             circles,
         } = self.config;
-        let mut group = PluginGroupBuilder::start::<Self>()
+        PluginGroupBuilder::start::<Self>()
             .add(StepPlugin {
                 arena,
                 solver,
@@ -131,17 +111,12 @@ impl PluginGroup for CirclesPlugins {
                 circles,
             })
             .add(IntegratePlugin)
+            .add(GravityPlugin)
+            .add(DragPlugin)
+            .add(WallsPlugin)
+            .add(PeriodicPlugin)
+            .add(CollidePlugin)
             .add(ContinuousPlugin)
-            .add(DiagnosticsPlugin);
-        for effect in Effect::called_for(&effects) {
-            group = match effect {
-                Effect::Gravity => group.add(GravityPlugin),
-                Effect::Drag => group.add(DragPlugin),
-                Effect::Walls => group.add(WallsPlugin),
-                Effect::Periodic => group.add(PeriodicPlugin),
-                Effect::Collisions => group.add(CollidePlugin),
-            };
-        }
-        group
+            .add(DiagnosticsPlugin)
     }
 }

@@ -1,8 +1,10 @@
-//! Headless batch runs: build a `MinimalPlugins` app from a configuration, step it a given number
-//! of fixed steps as fast as it goes, and report what happened ([`Report`], the JSON that
-//! `moving_circles run --report` writes; its fields are a contract other tools rely on).
+//! Headless runs: [`headless_app`], a `MinimalPlugins` app in which every `update()` is exactly
+//! one fixed step; [`run_steps`], the one loop that steps such an app, times the stepping alone
+//! and measures the state as it goes (the `run` command, the accuracy study and the hard-case
+//! tests all use it); and [`Report`], what a run did — the JSON `moving_circles run --report`
+//! writes, whose fields are a contract other tools rely on.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
@@ -10,13 +12,17 @@ use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
 
 use crate::CirclesPlugins;
-use crate::collide::collision_space;
-use crate::components::{Mass, Position, Radius, Tint, Velocity};
-use crate::config::{Arena, Boundary, CirclesConfig, Effects};
-use crate::diagnostics::{CollisionCounters, Overlaps, Pressure, Totals, relative_change};
-use crate::effects::Effect;
+use crate::arena::Arena;
+use crate::boundary::WallCollisions;
+use crate::circle::{CircleState, discs, snapshot};
+use crate::collide::PairCollisions;
+use crate::collide::overlaps::Overlaps;
+use crate::config::{CirclesConfig, Effects, Solver};
+use crate::diagnostics::{Pressure, Totals, relative_change};
+use crate::effects::{Effect, EffectRegistry};
 use crate::exact::EngineState;
-use crate::spawn::{CircleInit, SpawnReport};
+use crate::schedule::StepTotals;
+use crate::spawn::SpawnReport;
 
 /// A headless app for `config`, past `Startup` (circles spawned), in which every `update()`
 /// advances exactly one fixed step.
@@ -24,12 +30,27 @@ use crate::spawn::{CircleInit, SpawnReport};
 /// Every schedule runs on the single-threaded executor: a headless step is a chain of systems
 /// with nothing to overlap, and the multi-threaded executor's thread wake-ups in each of the
 /// dozen schedules of an `update()` cost more than the stepping of 10 000 circles without
-/// collisions (measured: `step_effects/walls_only/10000` 534 µs before, see the README).
-/// Kernels that do parallelise (the pair scan) still use the task pools.
+/// collisions. Kernels that do parallelise (the pair scan) still use the task pools.
+///
+/// ```
+/// use moving_circles::prelude::*;
+/// use moving_circles::run::headless_app;
+///
+/// let mut app = headless_app(CirclesConfig::default());
+/// app.update();
+/// assert_eq!(app.world().resource::<StepTotals>().steps, 1);
+/// ```
 pub fn headless_app(config: CirclesConfig) -> App {
+    headless_app_with(config, |_| {})
+}
+
+/// [`headless_app`] with more added by `setup` before the app is finished: your own plugins,
+/// or the app's input and HUD plugins in a test.
+pub fn headless_app_with(config: CirclesConfig, setup: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, CirclesPlugins::new(config)))
         .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
+    setup(&mut app);
     app.finish();
     app.cleanup();
     for (_, schedule) in app.world_mut().resource_mut::<Schedules>().iter_mut() {
@@ -39,33 +60,67 @@ pub fn headless_app(config: CirclesConfig) -> App {
     app
 }
 
-/// Every circle's state, in query order.
-pub fn snapshot(world: &mut World) -> Vec<CircleInit> {
-    world
-        .query::<(&Position, &Velocity, &Radius, &Mass, &Tint)>()
-        .iter(world)
-        .map(|(p, v, r, m, t)| CircleInit {
-            position: p.0,
-            velocity: v.0,
-            radius: r.0,
-            mass: m.0,
-            tint: t.0,
-        })
-        .collect()
+/// One look at the state after a step of [`run_steps`].
+pub struct Sample<'a> {
+    /// Steps done so far.
+    pub step: u64,
+    /// Every circle, in spawn order.
+    pub circles: &'a [CircleState],
+    /// The app's world, for anything else.
+    pub world: &'a mut World,
 }
 
+/// How often [`run_steps`] samples the state by default: after every step up to 10 000
+/// circles, after every 10th above (the report's overlaps are measured on those samples).
+pub fn default_sampling(circles: usize) -> u64 {
+    if circles <= 10_000 { 1 } else { 10 }
+}
+
+/// Steps `app` `steps` times, timing the steps alone. After every `sample_every`-th step (and
+/// the last) it takes a snapshot, measures its overlaps and hands it to `observe`, outside the
+/// timed stepping. Returns the report of the run, with `source` as its source.
+pub fn run_steps(
+    app: &mut App,
+    source: &str,
+    steps: u64,
+    sample_every: u64,
+    mut observe: impl FnMut(Sample),
+) -> Report {
+    let before = totals(app.world_mut());
+    let mut overlaps = Overlaps::default();
+    let mut stepping = Duration::ZERO;
+    for step in 1..=steps {
+        let start = Instant::now();
+        app.update();
+        stepping += start.elapsed();
+        if step % sample_every.max(1) == 0 || step == steps {
+            let world = app.world_mut();
+            let circles = snapshot(world);
+            let arena = *world.resource::<Arena>();
+            overlaps.add(Overlaps::measure(&discs(&circles), &arena));
+            observe(Sample {
+                step,
+                circles: &circles,
+                world,
+            });
+        }
+    }
+    let world = app.world_mut();
+    let after = totals(world);
+    Report::new(world, source, before, after, overlaps, stepping)
+}
+
+/// Mechanical energy, momentum and counts of the world's circles under its arena and gravity.
 fn totals(world: &mut World) -> Totals {
-    let arena = *world.resource::<Arena>();
-    let gravity = world.resource::<Effects>().gravity;
     let circles = snapshot(world);
     Totals::measure(
         circles.iter().map(|c| (c.position, c.velocity, c.mass)),
-        &arena,
-        gravity,
+        world.resource::<Arena>(),
+        world.resource::<Effects>().gravity,
     )
 }
 
-/// What a headless run did. Field names and meanings are stable (DESIGN.md).
+/// What a headless run did. Field names and meanings are stable: other tools read them.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Report {
     /// Where the circles came from (scene or particle file).
@@ -120,90 +175,63 @@ pub struct Report {
     pub budget_exhausted: u64,
 }
 
-/// Overlaps of the current state (see [`Overlaps`]).
-pub fn overlaps(world: &mut World) -> Overlaps {
-    let arena = *world.resource::<Arena>();
-    let boundary = world.resource::<Effects>().boundary;
-    Overlaps::measure(&snapshot(world), collision_space(&arena, boundary))
-}
-
-/// Steps `app` `steps` times, calling `progress(done)` now and then, and reports. Overlaps are
-/// measured after every step (every 10th above 10 000 circles), outside the timed stepping.
-pub fn run_steps(app: &mut App, source: &str, steps: u64, mut progress: impl FnMut(u64)) -> Report {
-    let before = totals(app.world_mut());
-    let every = (steps / 200).max(1);
-    let sample_every = if before.count <= 10_000 { 1 } else { 10 };
-    let mut worst = Overlaps::default();
-    let (mut overlap_sum, mut sampled_pairs) = (0.0, 0usize);
-    let mut wall = std::time::Duration::ZERO;
-    for step in 1..=steps {
-        let start = Instant::now();
-        app.update();
-        wall += start.elapsed();
-        if step % sample_every == 0 || step == steps {
-            let o = overlaps(app.world_mut());
-            worst.max = worst.max.max(o.max);
-            overlap_sum += o.sum;
-            sampled_pairs += o.pairs;
+impl Report {
+    fn new(
+        world: &World,
+        source: &str,
+        before: Totals,
+        after: Totals,
+        overlaps: Overlaps,
+        stepping: Duration,
+    ) -> Self {
+        let elapsed = *world.resource::<StepTotals>();
+        let pairs = *world.resource::<PairCollisions>();
+        let walls = *world.resource::<WallCollisions>();
+        let arena = *world.resource::<Arena>();
+        let registry = world.resource::<EffectRegistry>();
+        let pressure = Pressure::measure(
+            &elapsed,
+            &pairs,
+            &walls,
+            after.count,
+            after.kinetic_energy,
+            &arena,
+        );
+        let wall_seconds = stepping.as_secs_f64();
+        Report {
+            source: source.to_owned(),
+            n: after.count,
+            requested: world.resource::<SpawnReport>().requested,
+            solver: world.resource::<Solver>().to_string(),
+            boundary: arena.boundary.to_string(),
+            effects: Effect::ALL
+                .into_iter()
+                .filter(|&e| registry.is_scheduled(e))
+                .map(|e| e.name().to_owned())
+                .collect(),
+            dt: world.resource::<Time<Fixed>>().timestep().as_secs_f64(),
+            steps: elapsed.steps,
+            sim_seconds: elapsed.sim_seconds,
+            wall_seconds,
+            ms_per_step: if elapsed.steps > 0 {
+                1e3 * wall_seconds / elapsed.steps as f64
+            } else {
+                0.0
+            },
+            energy_initial: before.energy(),
+            energy_final: after.energy(),
+            energy_drift: relative_change(before.energy(), after.energy()),
+            momentum_initial: before.momentum.to_array(),
+            momentum_final: after.momentum.to_array(),
+            max_penetration: overlaps.max,
+            mean_penetration: overlaps.mean(),
+            escaped: after.escaped,
+            non_finite: after.non_finite,
+            pair_collisions: pairs.count,
+            wall_collisions: walls.count,
+            z: pressure.z_virial,
+            z_wall: pressure.z_wall,
+            budget_exhausted: world.resource::<EngineState>().budget_exhausted,
         }
-        if step % every == 0 {
-            progress(step);
-        }
-    }
-    let wall_seconds = wall.as_secs_f64();
-    let world = app.world_mut();
-    let after = totals(world);
-    let counters = *world.resource::<CollisionCounters>();
-    let effects = *world.resource::<Effects>();
-    let arena = *world.resource::<Arena>();
-    let spawn = *world.resource::<SpawnReport>();
-    let pressure = Pressure::measure(
-        &counters,
-        after.count,
-        after.kinetic_energy,
-        &arena,
-        effects.boundary == Boundary::Walls,
-    );
-    Report {
-        source: source.to_owned(),
-        n: after.count,
-        requested: spawn.requested,
-        solver: world.resource::<crate::config::Solver>().to_string(),
-        boundary: match effects.boundary {
-            Boundary::Walls => "walls",
-            Boundary::Periodic => "periodic",
-        }
-        .to_owned(),
-        effects: Effect::called_for(&effects)
-            .iter()
-            .map(|e| format!("{e:?}").to_lowercase())
-            .collect(),
-        dt: world.resource::<Time<Fixed>>().timestep().as_secs_f64(),
-        steps: counters.steps,
-        sim_seconds: counters.sim_seconds,
-        wall_seconds,
-        ms_per_step: if steps > 0 {
-            1e3 * wall_seconds / steps as f64
-        } else {
-            0.0
-        },
-        energy_initial: before.energy(),
-        energy_final: after.energy(),
-        energy_drift: relative_change(before.energy(), after.energy()),
-        momentum_initial: before.momentum.to_array(),
-        momentum_final: after.momentum.to_array(),
-        max_penetration: worst.max,
-        mean_penetration: if sampled_pairs == 0 {
-            0.0
-        } else {
-            overlap_sum / sampled_pairs as f64
-        },
-        escaped: after.escaped,
-        non_finite: after.non_finite,
-        pair_collisions: counters.pair_collisions,
-        wall_collisions: counters.wall_collisions,
-        z: pressure.z_virial,
-        z_wall: pressure.z_wall,
-        budget_exhausted: world.resource::<EngineState>().budget_exhausted,
     }
 }

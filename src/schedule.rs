@@ -1,9 +1,12 @@
 //! When things run: the public [`CircleSystems`] sets, the [`CircleStep`] schedule that one
-//! (sub)step of the solver runs, and [`StepPlugin`], the core plugin every other plugin builds on.
+//! (sub)step of the discrete solvers runs, the [`ContinuousStep`] schedule of `swept` and
+//! `exact`, the [`StepTotals`] they advance, and [`StepPlugin`], the core plugin every other
+//! plugin builds on.
 //!
 //! Data flow per fixed step (in `FixedUpdate`):
 //! `CircleSystems::Step` runs [`CircleStep`] `substeps` times with `dt / substeps`
-//! (`Forces` → `Integrate` → `Boundary` → `Collide`), then `CircleSystems::Diagnostics` measures the result.
+//! (`Forces` → `Integrate` → `Boundary` → `Collide`), or [`ContinuousStep`] once
+//! (`Forces` → `Continuous`), then `CircleSystems::Diagnostics` measures the result.
 //! Spawning happens outside the fixed clock (`Startup` and `PreUpdate`, set `CircleSystems::Spawn`)
 //! so a paused simulation can still be reset.
 
@@ -13,8 +16,8 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 
-use crate::config::{Arena, Effects, Solver};
-use crate::diagnostics::CollisionCounters;
+use crate::arena::Arena;
+use crate::config::{Effects, Solver};
 
 /// The system sets of the simulation, in the order they run.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -49,6 +52,15 @@ pub struct ContinuousStep;
 /// The simulated time one run of [`CircleStep`] covers, in seconds (`dt / substeps`).
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
 pub struct StepDt(pub f64);
+
+/// Fixed steps advanced and the simulated time they covered, since the last (re)spawn.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepTotals {
+    /// Fixed steps advanced.
+    pub steps: u64,
+    /// Simulated seconds advanced.
+    pub sim_seconds: f64,
+}
 
 /// The core plugin: inserts the arena, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
 /// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
@@ -87,7 +99,7 @@ impl Plugin for StepPlugin {
                 self.dt,
             )))
             .init_resource::<StepDt>()
-            .init_resource::<CollisionCounters>()
+            .init_resource::<StepTotals>()
             .init_schedule(CircleStep)
             .init_schedule(ContinuousStep)
             // The step's systems run in a chain, so a multi-threaded executor would only add
@@ -124,7 +136,7 @@ impl Plugin for StepPlugin {
 /// Lets virtual time advance by at least one fixed step per frame: Bevy caps a frame's virtual
 /// delta (250 ms by default), which would otherwise stop a scene with a longer `dt` (a 1 s
 /// step) from ever stepping.
-pub fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Virtual>>) {
+pub(crate) fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Virtual>>) {
     let step = fixed.timestep();
     if virt.max_delta() < step {
         virt.set_max_delta(step);
@@ -133,7 +145,7 @@ pub fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Virtual>>
 
 /// Advances one fixed step with the current [`Solver`]: runs [`CircleStep`] once per substep
 /// with the substep's `dt`, or [`ContinuousStep`] once.
-pub fn run_circle_step(world: &mut World) {
+fn run_circle_step(world: &mut World) {
     let solver = *world.resource::<Solver>();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
     if solver.is_continuous() {
@@ -146,9 +158,9 @@ pub fn run_circle_step(world: &mut World) {
             world.run_schedule(CircleStep);
         }
     }
-    let mut counters = world.resource_mut::<CollisionCounters>();
-    counters.steps += 1;
-    counters.sim_seconds += dt;
+    let mut totals = world.resource_mut::<StepTotals>();
+    totals.steps += 1;
+    totals.sim_seconds += dt;
 }
 
 /// The schedules the simulation adds systems to, in the order a frame meets them.

@@ -1,84 +1,49 @@
 //! Seeded, non-overlapping random placement of circles ([`place_circles`], a plain function over
 //! plain data) and [`SpawnPlugin`], which spawns them at startup and on [`Respawn`] requests.
 //!
-//! Placement is rejection sampling against a uniform grid of the circles already placed, so each
-//! attempt checks a 3×3 block of cells instead of every circle: 100k circles place in well under a
-//! second. Work is bounded: each circle gets `attempts_per_circle` tries; when an arena is full the
-//! remaining circles are skipped and the shortfall is reported, never looped on.
+//! Placement is rejection sampling against a uniform [`Grid`] of the circles already placed, so
+//! each attempt checks a 3×3 block of cells instead of every circle: 100k circles place in well
+//! under a second. Work is bounded: each circle gets `attempts_per_circle` tries; when an arena
+//! is full the remaining circles are skipped and the shortfall is reported, never looped on.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::components::{Mass, Position, Radius, Tint, Velocity};
-use crate::config::{Arena, SpawnConfig};
+use crate::arena::Arena;
+use crate::circle::CircleState;
+use crate::components::Radius;
+use crate::config::SpawnConfig;
+use crate::error::FieldError;
+use crate::grid::{CellMembers, Grid};
 use crate::schedule::CircleSystems;
-
-/// The initial state of one circle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CircleInit {
-    /// Centre.
-    pub position: DVec2,
-    /// Velocity.
-    pub velocity: DVec2,
-    /// Radius.
-    pub radius: f64,
-    /// Mass.
-    pub mass: f64,
-    /// Colour.
-    pub tint: [u8; 3],
-}
-
-impl CircleInit {
-    /// The components of this circle, ready to spawn.
-    pub fn bundle(&self) -> (Radius, Position, Velocity, Mass, Tint) {
-        (
-            Radius(self.radius),
-            Position(self.position),
-            Velocity(self.velocity),
-            Mass(self.mass),
-            Tint(self.tint),
-        )
-    }
-}
-
-/// Why a spawn configuration cannot be used at all.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SpawnError {
-    /// The radius range is empty, non-finite or not positive.
-    #[error("spawn.radius: expected 0 < min <= max (finite), got ({0}, {1})")]
-    BadRadius(f64, f64),
-    /// The speed range is empty, non-finite or negative.
-    #[error("spawn.speed: expected 0 <= min <= max (finite), got ({0}, {1})")]
-    BadSpeed(f64, f64),
-    /// The arena has no area.
-    #[error("arena: expected min < max on both axes, got min {0} max {1}")]
-    BadArena(DVec2, DVec2),
-}
 
 /// Places up to [`SpawnConfig::target_count`] non-overlapping circles inside `arena`, largest
 /// first, around the `fixed` circles already there (which are not returned).
 ///
-/// Returns the circles that fit, which is fewer than requested when the arena is too full.
+/// Returns the circles that fit, which is fewer than requested when the arena is too full, or
+/// which field of the arena or the rules ([`SpawnConfig::check`]) makes placing impossible.
 /// The same config always gives the same circles.
+///
+/// ```
+/// use moving_circles::prelude::*;
+/// use moving_circles::spawn::place_circles;
+///
+/// let config = SpawnConfig { count: 100, ..SpawnConfig::default() };
+/// let circles = place_circles(&Arena::default(), &config, &[]).unwrap();
+/// assert_eq!(circles.len(), 100);
+/// assert_eq!(circles, place_circles(&Arena::default(), &config, &[]).unwrap());
+/// ```
 pub fn place_circles(
     arena: &Arena,
     config: &SpawnConfig,
-    fixed: &[CircleInit],
-) -> Result<Vec<CircleInit>, SpawnError> {
+    fixed: &[CircleState],
+) -> Result<Vec<CircleState>, FieldError> {
+    arena.check()?;
+    config.check(arena).map_err(|e| e.within("spawn"))?;
     let (r_min, r_max) = config.radius;
-    if !(r_min.is_finite() && r_max.is_finite() && r_min > 0.0 && r_min <= r_max) {
-        return Err(SpawnError::BadRadius(r_min, r_max));
-    }
     let (s_min, s_max) = config.speed;
-    if !(s_min.is_finite() && s_max.is_finite() && s_min >= 0.0 && s_min <= s_max) {
-        return Err(SpawnError::BadSpeed(s_min, s_max));
-    }
-    let size = arena.size();
-    if !(size.x > 0.0 && size.y > 0.0 && size.is_finite()) {
-        return Err(SpawnError::BadArena(arena.min, arena.max));
-    }
 
     let count = config.target_count(arena);
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
@@ -91,7 +56,7 @@ pub fn place_circles(
     // Fixed circles can be larger than any random one; the grid's cells must span the largest.
     let largest = fixed.iter().map(|c| c.radius).fold(r_max, f64::max);
     let mut grid = PlacementGrid::new(arena, largest, count + fixed.len());
-    let mut placed: Vec<CircleInit> = Vec::with_capacity(count + fixed.len());
+    let mut placed: Vec<CircleState> = Vec::with_capacity(count + fixed.len());
     for circle in fixed {
         grid.insert(circle.position, placed.len());
         placed.push(*circle);
@@ -114,7 +79,7 @@ pub fn place_circles(
         let speed = sample_between(&mut rng, s_min, s_max);
         let angle = rng.random_range(0.0..std::f64::consts::TAU);
         grid.insert(position, placed.len());
-        placed.push(CircleInit {
+        placed.push(CircleState {
             position,
             velocity: DVec2::from_angle(angle) * speed,
             radius: r,
@@ -161,65 +126,44 @@ fn hue_to_rgb(hue: f64) -> [u8; 3] {
 /// Circles placed so far, bucketed into square cells at least as wide as the largest diameter,
 /// so any overlap of a new circle is with a circle in its own or an adjacent cell.
 struct PlacementGrid {
-    origin: DVec2,
-    cell: f64,
-    cols: usize,
-    rows: usize,
-    /// First circle in each cell (`u32::MAX` = none); `next` chains the rest.
-    head: Vec<u32>,
-    next: Vec<u32>,
+    grid: Grid,
+    members: CellMembers,
 }
 
 impl PlacementGrid {
     fn new(arena: &Arena, r_max: f64, count: usize) -> Self {
         let size = arena.size();
         // Never more cells than about one per circle: a tiny radius in a big arena must not
-        // allocate millions of empty cells. Cells span the largest diameter, so a 3×3 block
-        // around a new circle holds every circle it could overlap.
+        // allocate millions of empty cells.
         let cell = (2.0 * r_max).max((size.x * size.y / count.max(1) as f64).sqrt());
         let cols = ((size.x / cell).ceil() as usize).max(1);
         let rows = ((size.y / cell).ceil() as usize).max(1);
+        let grid = Grid::square(arena.min, cell, cols, rows);
         Self {
-            origin: arena.min,
-            cell,
-            cols,
-            rows,
-            head: vec![u32::MAX; cols * rows],
-            next: Vec::with_capacity(count),
+            members: CellMembers::new(grid.len(), count),
+            grid,
         }
     }
 
     fn cell_of(&self, p: DVec2) -> (usize, usize) {
-        let c = ((p - self.origin) / self.cell).floor();
-        (
-            (c.x.max(0.0) as usize).min(self.cols - 1),
-            (c.y.max(0.0) as usize).min(self.rows - 1),
-        )
+        self.grid.cell_of(p)
     }
 
     fn insert(&mut self, p: DVec2, index: usize) {
-        let (cx, cy) = self.cell_of(p);
-        let slot = cy * self.cols + cx;
-        self.next.push(self.head[slot]);
-        self.head[slot] = index as u32;
+        let (x, y) = self.grid.cell_of(p);
+        self.members.insert(index, self.grid.index(x, y));
     }
 
-    fn overlaps_any(&self, p: DVec2, r: f64, placed: &[CircleInit]) -> bool {
-        let (cx, cy) = self.cell_of(p);
-        for y in cy.saturating_sub(1)..=(cy + 1).min(self.rows - 1) {
-            for x in cx.saturating_sub(1)..=(cx + 1).min(self.cols - 1) {
-                let mut i = self.head[y * self.cols + x];
-                while i != u32::MAX {
-                    let other = &placed[i as usize];
-                    let reach = r + other.radius;
-                    if p.distance_squared(other.position) < reach * reach {
-                        return true;
-                    }
-                    i = self.next[i as usize];
-                }
-            }
-        }
-        false
+    fn overlaps_any(&self, p: DVec2, r: f64, placed: &[CircleState]) -> bool {
+        let (x, y) = self.grid.cell_of(p);
+        let (cells, len) = self.grid.block(x, y);
+        cells[..len].iter().any(|&cell| {
+            self.members.members(cell).any(|i| {
+                let other = &placed[i];
+                let reach = r + other.radius;
+                p.distance_squared(other.position) < reach * reach
+            })
+        })
     }
 }
 
@@ -241,7 +185,7 @@ pub struct SpawnReport {
 
 /// Circles a scene places exactly, before the random ones.
 #[derive(Resource, Clone, Debug, Default, PartialEq)]
-pub struct FixedCircles(pub Vec<CircleInit>);
+pub struct FixedCircles(pub Vec<CircleState>);
 
 /// Spawns the [`FixedCircles`] and random circles from a [`SpawnConfig`] at startup and on
 /// every [`Respawn`].
@@ -250,7 +194,7 @@ pub struct SpawnPlugin {
     /// Random circles to place.
     pub config: SpawnConfig,
     /// Circles to place exactly as given.
-    pub circles: Vec<CircleInit>,
+    pub circles: Vec<CircleState>,
 }
 
 impl Plugin for SpawnPlugin {
@@ -271,7 +215,7 @@ impl Plugin for SpawnPlugin {
 }
 
 /// Spawns the [`FixedCircles`], then random circles placed from the [`SpawnConfig`].
-pub fn spawn_circles(
+fn spawn_circles(
     mut commands: Commands,
     arena: Res<Arena>,
     config: Res<SpawnConfig>,
@@ -301,13 +245,13 @@ pub fn spawn_circles(
         .0
         .iter()
         .chain(&random)
-        .map(CircleInit::bundle)
+        .map(CircleState::bundle)
         .collect();
     commands.spawn_batch(bundles);
 }
 
 /// Despawns every circle and places a fresh set.
-pub fn respawn_circles(
+fn respawn_circles(
     mut commands: Commands,
     mut requests: MessageReader<Respawn>,
     circles: Query<Entity, With<Radius>>,

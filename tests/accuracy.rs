@@ -5,19 +5,12 @@
 use std::process::Command;
 
 use bevy::math::DVec2;
-use moving_circles::accuracy::{choose_solver, passed_through};
-use moving_circles::collide::broad_phase::Space;
+use moving_circles::accuracy::auto::choose_solver;
+use moving_circles::accuracy::passed_through;
 use moving_circles::prelude::*;
-use moving_circles::spawn::CircleInit;
 
-fn circle(x: f64, vx: f64) -> CircleInit {
-    CircleInit {
-        position: DVec2::new(x, 0.0),
-        velocity: DVec2::new(vx, 0.0),
-        radius: 0.1,
-        mass: 1.0,
-        tint: [0; 3],
-    }
+fn circle(x: f64, vx: f64) -> CircleState {
+    CircleState::new(DVec2::new(x, 0.0), DVec2::new(vx, 0.0), 0.1)
 }
 
 #[test]
@@ -25,26 +18,26 @@ fn passing_through_is_counted_and_bouncing_is_not() {
     let before = [circle(-0.3, 6.0), circle(0.3, -6.0)];
     // One step of 0.1 s later, unchanged velocities, on the far sides: tunnelled.
     let tunnelled = [circle(0.3, 6.0), circle(-0.3, -6.0)];
-    assert_eq!(passed_through(&before, &tunnelled, Space::Open), 1);
+    assert_eq!(passed_through(&before, &tunnelled, &Arena::default()), 1);
     // Bounced back: velocities changed, same sides.
     let bounced = [circle(-0.3, -6.0), circle(0.3, 6.0)];
-    assert_eq!(passed_through(&before, &bounced, Space::Open), 0);
+    assert_eq!(passed_through(&before, &bounced, &Arena::default()), 0);
     // Missed each other sideways: no overlap on the way.
     let wide = [
-        CircleInit {
+        CircleState {
             position: DVec2::new(-0.3, 0.5),
             ..circle(0.0, 6.0)
         },
         circle(0.3, -6.0),
     ];
     let wide_after = [
-        CircleInit {
+        CircleState {
             position: DVec2::new(0.3, 0.5),
             ..circle(0.0, 6.0)
         },
         circle(-0.3, -6.0),
     ];
-    assert_eq!(passed_through(&wide, &wide_after, Space::Open), 0);
+    assert_eq!(passed_through(&wide, &wide_after, &Arena::default()), 0);
 }
 
 fn fast_scene() -> CirclesConfig {

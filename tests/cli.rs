@@ -25,6 +25,16 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// Runs `moving_circles` with `args` and `--report DIR/r.json`; the report, stdout and stderr.
+fn run_with_report(dir: &Path, args: &[&str]) -> (serde_json::Value, String, String) {
+    let report = dir.join("r.json");
+    let mut args = args.to_vec();
+    args.extend(["--report", report.to_str().unwrap()]);
+    let (stdout, stderr) = moving_circles(&args);
+    let json = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    (json, stdout, stderr)
+}
+
 const REPORT_FIELDS: [&str; 17] = [
     "n",
     "solver",
@@ -48,27 +58,24 @@ const REPORT_FIELDS: [&str; 17] = [
 #[test]
 fn run_writes_every_report_field_and_dumps_the_final_state() {
     let dir = temp_dir("run");
-    let report = dir.join("r.json");
     let dump = dir.join("final.txt");
-    let (stdout, stderr) = moving_circles(&[
-        "run",
-        "--particles",
-        "tests/data/particles/billiards5.txt",
-        "--seconds",
-        "20",
-        "--report",
-        report.to_str().unwrap(),
-        "--dump",
-        dump.to_str().unwrap(),
-    ]);
+    let (json, stdout, stderr) = run_with_report(
+        &dir,
+        &[
+            "run",
+            "--particles",
+            "tests/data/particles/billiards5.txt",
+            "--seconds",
+            "20",
+            "--dump",
+            dump.to_str().unwrap(),
+        ],
+    );
     assert!(stdout.contains("16 circles"), "{stdout}");
     assert!(
         stderr.is_empty(),
         "no progress bar when piped, got: {stderr:?}"
     );
-
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     for field in REPORT_FIELDS {
         assert!(json.get(field).is_some(), "report lacks `{field}`: {json}");
     }
@@ -98,18 +105,16 @@ fn energy_drift_is_finite_when_nothing_moves() {
         "2\n0.25 0.5 0 0 0.1 1 9 9 9\n0.75 0.5 0 0 0.1 1 9 9 9\n",
     )
     .unwrap();
-    let report = dir.join("r.json");
-    moving_circles(&[
-        "run",
-        "--particles",
-        input.to_str().unwrap(),
-        "--steps",
-        "10",
-        "--report",
-        report.to_str().unwrap(),
-    ]);
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let (json, ..) = run_with_report(
+        &dir,
+        &[
+            "run",
+            "--particles",
+            input.to_str().unwrap(),
+            "--steps",
+            "10",
+        ],
+    );
     assert_eq!(json["energy_drift"], 0.0);
     assert!(
         json["z"].is_null(),
@@ -121,20 +126,18 @@ fn energy_drift_is_finite_when_nothing_moves() {
 #[test]
 fn periodic_particle_runs_wrap_instead_of_bouncing() {
     let dir = temp_dir("periodic");
-    let report = dir.join("r.json");
-    moving_circles(&[
-        "run",
-        "--particles",
-        "tests/data/particles/diagonal.txt",
-        "--boundary",
-        "periodic",
-        "--seconds",
-        "200",
-        "--report",
-        report.to_str().unwrap(),
-    ]);
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let (json, ..) = run_with_report(
+        &dir,
+        &[
+            "run",
+            "--particles",
+            "tests/data/particles/diagonal.txt",
+            "--boundary",
+            "periodic",
+            "--seconds",
+            "200",
+        ],
+    );
     assert_eq!(json["boundary"], "periodic");
     assert_eq!(json["wall_collisions"], 0);
     assert_eq!(json["escaped"], 0);

@@ -28,10 +28,7 @@ fn a_head_on_equal_mass_hit_swaps_velocities() {
     step(&mut app, 60);
     let (_, va) = state(&app, a);
     let (_, vb) = state(&app, b);
-    assert_eq!(
-        app.world().resource::<CollisionCounters>().pair_collisions,
-        1
-    );
+    assert_eq!(pair_collisions(&app), 1);
     assert_eq!(
         (va, vb),
         (DVec2::new(-1.0, 0.0), DVec2::new(3.0, 0.0)),
@@ -60,11 +57,7 @@ fn an_oblique_hit_of_unequal_masses_conserves_momentum_and_energy() {
     // Momentum components can nearly cancel, so their error is judged against Σ m|v|.
     let scale: f64 = circles(&mut app).iter().map(|c| c.3 * c.1.length()).sum();
     step(&mut app, 90);
-    assert_eq!(
-        app.world().resource::<CollisionCounters>().pair_collisions,
-        1,
-        "one hit"
-    );
+    assert_eq!(pair_collisions(&app), 1, "one hit");
     let (e1, p1) = energy_momentum(&mut app);
     // The impulse is a handful of f64 operations on O(1) values: rounding is a few ulp of f64
     // (≈1e-16 relative). 1e-12 leaves ample room for that and fails on any modelling error.
@@ -114,11 +107,8 @@ fn a_crowded_box_conserves_momentum_away_from_walls_and_energy_stays_bounded() {
     let mut app = create_app(config);
     let (e0, _) = energy_momentum(&mut app);
     step(&mut app, 300);
-    let counters = *app.world().resource::<CollisionCounters>();
-    assert!(
-        counters.pair_collisions > 100,
-        "a crowded box collides: {counters:?}"
-    );
+    let collisions = pair_collisions(&app);
+    assert!(collisions > 100, "a crowded box collides: {collisions}");
     let (e1, _) = energy_momentum(&mut app);
     // Elastic impulses conserve energy; the discrete method's only energy error is collisions
     // resolved at already-overlapped positions, which stays small at this density.

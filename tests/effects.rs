@@ -87,12 +87,7 @@ fn periodic_circles_collide_across_the_seam() {
     );
     step(&mut app, 30);
     let cs = circles(&mut app);
-    assert_eq!(
-        app.world()
-            .resource::<moving_circles::prelude::CollisionCounters>()
-            .pair_collisions,
-        1
-    );
+    assert_eq!(pair_collisions(&app), 1);
     assert_eq!(
         (cs[0].1, cs[1].1),
         (DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0)),

@@ -21,11 +21,11 @@ use std::path::Path;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
-use moving_circles::collide::collision_space;
-use moving_circles::diagnostics::overlapping_circles;
+use moving_circles::circle::{CircleState, discs, snapshot};
+use moving_circles::collide::overlaps::overlapping_circles;
 use moving_circles::prelude::*;
+use moving_circles::run::run_steps;
 use moving_circles::scene::particles;
-use moving_circles::spawn::CircleInit;
 
 /// Overlap (in smaller radii) that is rounding, not penetration.
 const ROUNDING: f64 = 1e-9;
@@ -43,15 +43,7 @@ fn load(name: &str) -> CirclesConfig {
         .join(name);
     if name.ends_with(".txt") {
         let circles = particles::read(&path, Boundary::Walls).unwrap_or_else(|e| panic!("{e}"));
-        CirclesConfig {
-            arena: particles::unit_square(),
-            spawn: SpawnConfig {
-                count: 0,
-                ..default()
-            },
-            circles,
-            ..default()
-        }
+        particles::to_config(circles, Boundary::Walls)
     } else {
         Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
     }
@@ -68,62 +60,58 @@ struct Outcome {
     momentum_drift: Option<f64>,
     pair_collisions: u64,
     wall_collisions: u64,
-    start: Vec<CircleInit>,
-    end: Vec<CircleInit>,
+    start: Vec<CircleState>,
+    end: Vec<CircleState>,
 }
 
+/// Runs `steps` steps of case `name` under `solver` through the same loop `moving_circles run`
+/// uses, following every overlap beyond rounding from step to step.
 fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
     let config = CirclesConfig {
         solver,
         ..load(name)
     };
-    let space = collision_space(&config.arena, config.effects.boundary);
     let arena = config.arena;
     let mut app = create_app(config);
-    let state = |app: &mut App| moving_circles::run::snapshot(app.world_mut());
-    let start = state(&mut app);
-    let (e0, p0) = energy_momentum(&mut app);
-    let mut outcome = Outcome::default();
-    let mut overlapped_for: HashMap<(u32, u32), u32> = HashMap::new();
-    for _ in 0..steps {
-        step(&mut app, 1);
-        let now = state(&mut app);
+    let start = snapshot(app.world_mut());
+    let mut longest_overlap_steps = 0;
+    let mut overlapped_for: HashMap<(usize, usize), u32> = HashMap::new();
+    let mut end = Vec::new();
+    let report = run_steps(&mut app, name, steps, 1, |sample| {
+        let now = sample.circles;
         let mut still = HashMap::new();
-        for (i, j, depth) in overlapping_circles(&now, space) {
-            let (i, j) = (i as u32, j as u32);
-            let depth = depth / now[i as usize].radius.min(now[j as usize].radius);
-            outcome.max_overlap = outcome.max_overlap.max(depth);
+        for (i, j, depth) in overlapping_circles(&discs(now), &arena) {
             // Touching to rounding (exactly touching circles) is contact, not an overlap to fix.
-            if depth <= ROUNDING {
+            if depth / now[i].radius.min(now[j].radius) <= ROUNDING {
                 continue;
             }
             let steps = overlapped_for.get(&(i, j)).copied().unwrap_or(0) + 1;
-            outcome.longest_overlap_steps = outcome.longest_overlap_steps.max(steps);
+            longest_overlap_steps = longest_overlap_steps.max(steps);
             still.insert((i, j), steps);
         }
         overlapped_for = still;
-    }
-    let end = state(&mut app);
-    let (e1, p1) = energy_momentum(&mut app);
-    let counters = *app.world().resource::<CollisionCounters>();
-    outcome.non_finite = end
-        .iter()
-        .filter(|c| !(c.position.is_finite() && c.velocity.is_finite()))
-        .count();
-    outcome.escaped = end.iter().filter(|c| !arena.contains(c.position)).count();
-    outcome.energy_drift = if e0 > 0.0 {
-        (e1 - e0).abs() / e0
-    } else {
-        (e1 - e0).abs()
-    };
+        end = now.to_vec();
+    });
+    assert_eq!(
+        report.steps, steps,
+        "{name} under {solver}: fixed steps run"
+    );
     let scale: f64 = start.iter().map(|c| c.mass * c.velocity.length()).sum();
-    outcome.momentum_drift =
-        (counters.wall_collisions == 0 && scale > 0.0).then(|| (p1 - p0).length() / scale);
-    outcome.pair_collisions = counters.pair_collisions;
-    outcome.wall_collisions = counters.wall_collisions;
-    outcome.start = start;
-    outcome.end = end;
-    outcome
+    let momentum = |p: [f64; 2]| DVec2::from_array(p);
+    Outcome {
+        non_finite: report.non_finite,
+        escaped: report.escaped,
+        max_overlap: report.max_penetration,
+        longest_overlap_steps,
+        energy_drift: report.energy_drift.abs(),
+        momentum_drift: (report.wall_collisions == 0 && scale > 0.0).then(|| {
+            (momentum(report.momentum_final) - momentum(report.momentum_initial)).length() / scale
+        }),
+        pair_collisions: report.pair_collisions,
+        wall_collisions: report.wall_collisions,
+        start,
+        end,
+    }
 }
 
 /// Runs `name` under every solver, checks the common invariants and returns the outcomes for

@@ -55,16 +55,10 @@ fn a_wall_hit_reflects_and_stays_inside() {
     for _ in 0..600 {
         step(&mut app, 1);
         let (p, vel) = state(&app, circle);
-        assert!(
-            p.x - r >= arena.min.x
-                && p.x + r <= arena.max.x
-                && p.y - r >= arena.min.y
-                && p.y + r <= arena.max.y,
-            "circle left the arena: centre {p}, radius {r}"
-        );
+        assert_inside(&arena, p, r, "the circle");
         assert_eq!(vel.abs(), v.abs(), "walls only flip velocity components");
         reflected |= vel.x < 0.0;
     }
     assert!(reflected, "the circle never bounced off the right wall");
-    assert!(app.world().resource::<CollisionCounters>().wall_collisions > 0);
+    assert!(wall_collisions(&app) > 0);
 }

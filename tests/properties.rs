@@ -2,11 +2,15 @@
 //! time of impact, the contact kernel (impulse + separation), wall reflection and the event
 //! engine. Each property is an invariant the code must keep for every input.
 
+mod common;
+
 use bevy::math::DVec2;
+use common::unit_box_gas;
+use moving_circles::arena::Arena;
 use moving_circles::boundary::reflect_off_walls;
-use moving_circles::collide::contact::{Body, resolve_contact};
-use moving_circles::config::Arena;
-use moving_circles::exact::engine::{Bounds, Circle, EventEngine};
+use moving_circles::circle::CircleState;
+use moving_circles::collide::contact::resolve_contact;
+use moving_circles::exact::engine::EventEngine;
 use moving_circles::exact::toi::pair_time_of_impact;
 use proptest::prelude::*;
 
@@ -48,10 +52,10 @@ proptest! {
         pa in vector(), off in vector(), va in vector(), vb in vector(),
         ra in positive(), rb in positive(), ma in positive(), mb in positive(),
     ) {
-        let mut a = Body { position: pa, velocity: va, radius: ra, inv_mass: 1.0 / ma };
+        let mut a = CircleState::new(pa, va, ra).with_mass(ma);
         // Put b within reach of a, so the pair overlaps (the interesting case).
         let reach = (ra + rb) * 0.999;
-        let mut b = Body { position: pa + off.normalize_or(DVec2::X) * (reach * 0.5), velocity: vb, radius: rb, inv_mass: 1.0 / mb };
+        let mut b = CircleState::new(pa + off.normalize_or(DVec2::X) * (reach * 0.5), vb, rb).with_mass(mb);
         let (a0, b0) = (a, b);
         let p0 = va * ma + vb * mb;
         let e0 = 0.5 * ma * va.length_squared() + 0.5 * mb * vb.length_squared();
@@ -78,7 +82,7 @@ proptest! {
 
     #[test]
     fn walls_keep_every_circle_inside_with_its_speed(p in vector(), v in vector(), r in 0.001f64..0.4) {
-        let arena = Arena { min: DVec2::new(-1.0, -1.0), max: DVec2::new(1.0, 1.0) };
+        let arena = Arena::centered(DVec2::splat(2.0));
         let (mut q, mut w) = (p, v);
         reflect_off_walls(&mut q, &mut w, r, &arena, 1.0);
         prop_assert!(q.is_finite() && w.is_finite());
@@ -95,21 +99,9 @@ proptest! {
         seeds in prop::collection::vec((0.05f64..0.95, 0.05f64..0.95, -1.0f64..1.0, -1.0f64..1.0, 0.005f64..0.03, 0.1f64..10.0), 2..40),
         periodic in any::<bool>(),
     ) {
-        // Keep only circles that do not overlap the ones before them.
-        let mut circles: Vec<Circle> = Vec::new();
-        for (x, y, vx, vy, r, m) in seeds {
-            let p = DVec2::new(x, y);
-            if circles.iter().all(|c| c.position.distance(p) > c.radius + r) {
-                circles.push(Circle { position: p, velocity: DVec2::new(vx, vy), radius: r, inv_mass: 1.0 / m });
-            }
-        }
-        let bounds = if periodic {
-            Bounds::Periodic { min: DVec2::ZERO, size: DVec2::ONE }
-        } else {
-            Bounds::Walls { min: DVec2::ZERO, max: DVec2::ONE }
-        };
-        let energy = |e: &EventEngine| (0..e.len()).map(|i| 0.5 / circles[i].inv_mass * e.velocity(i).length_squared()).sum::<f64>();
-        let mut engine = EventEngine::new(&circles, bounds, 1.0, 1.0);
+        let (circles, arena) = unit_box_gas(&seeds, periodic);
+        let energy = |e: &EventEngine| (0..e.len()).map(|i| 0.5 * circles[i].mass * e.velocity(i).length_squared()).sum::<f64>();
+        let mut engine = EventEngine::new(&circles, &arena, 1.0, 1.0);
         let e0 = energy(&engine);
         for step in 1..=20 {
             prop_assert!(engine.advance_to(step as f64 * 0.05, u64::MAX).is_ok());

@@ -5,7 +5,6 @@ mod common;
 
 use bevy::app::PluginGroup;
 use bevy::ecs::schedule::{LogLevel, ScheduleBuildSettings};
-use bevy::math::DVec2;
 use bevy::prelude::*;
 use common::*;
 use moving_circles::prelude::*;
@@ -90,20 +89,7 @@ fn without_collisions_there_is_no_collision_system() {
         },
         ..default()
     }));
-    spawn_circle(
-        &mut app,
-        DVec2::new(-1.0, 0.0),
-        DVec2::new(1.0, 0.0),
-        0.5,
-        1.0,
-    );
-    spawn_circle(
-        &mut app,
-        DVec2::new(1.0, 0.0),
-        DVec2::new(-1.0, 0.0),
-        0.5,
-        1.0,
-    );
+    spawn_head_on(&mut app, 1.0, 1.0, 0.5);
     step(&mut app, 120);
     let xs: Vec<f64> = circles(&mut app).iter().map(|c| c.0.x).collect();
     assert!(

@@ -34,10 +34,9 @@ fn drift_over_100_seconds(solver: Solver) -> (f64, u64) {
     let (e0, _) = energy_momentum(&mut app);
     step(&mut app, 6000);
     let (e1, _) = energy_momentum(&mut app);
-    let counters = *app.world().resource::<CollisionCounters>();
     assert_eq!(app.world().resource::<CircleDiagnostics>().non_finite, 0);
     assert_eq!(app.world().resource::<CircleDiagnostics>().escaped, 0);
-    ((e1 - e0).abs() / e0, counters.pair_collisions)
+    ((e1 - e0).abs() / e0, pair_collisions(&app))
 }
 
 #[test]
@@ -63,25 +62,9 @@ fn fast_pair(solver: Solver) -> (u64, Vec<(DVec2, DVec2, f64, f64)>) {
         solver,
         ..default()
     }));
-    spawn_circle(
-        &mut app,
-        DVec2::new(-1.0, 0.0),
-        DVec2::new(4.8, 0.0),
-        0.01,
-        1.0,
-    );
-    spawn_circle(
-        &mut app,
-        DVec2::new(1.0, 0.0),
-        DVec2::new(-4.8, 0.0),
-        0.01,
-        1.0,
-    );
+    spawn_head_on(&mut app, 1.0, 4.8, 0.01);
     step(&mut app, 20);
-    (
-        app.world().resource::<CollisionCounters>().pair_collisions,
-        circles(&mut app),
-    )
+    (pair_collisions(&app), circles(&mut app))
 }
 
 #[test]

@@ -11,13 +11,7 @@ use moving_circles::spawn::place_circles;
 
 fn assert_valid_placement(arena: &Arena, placed: &[(DVec2, f64)]) {
     for (i, &(p, r)) in placed.iter().enumerate() {
-        assert!(
-            p.x - r >= arena.min.x
-                && p.x + r <= arena.max.x
-                && p.y - r >= arena.min.y
-                && p.y + r <= arena.max.y,
-            "circle {i} at {p} with radius {r} is not inside {arena:?}"
-        );
+        assert_inside(arena, p, r, &format!("circle {i}"));
         for (j, &(q, s)) in placed.iter().enumerate().skip(i + 1) {
             assert!(
                 p.distance(q) >= r + s,
@@ -110,7 +104,7 @@ fn the_same_seed_gives_the_same_state_after_600_steps() {
         };
         let mut app = create_app(config);
         step(&mut app, 600);
-        assert!(app.world().resource::<CollisionCounters>().pair_collisions > 0);
+        assert!(pair_collisions(&app) > 0);
         state_hash(&mut app)
     };
     let first = run(5);

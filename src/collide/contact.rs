@@ -1,21 +1,11 @@
-//! Narrow phase of the `discrete` solver for one pair: positional separation along the contact
-//! normal split by inverse mass, then the restitution impulse if (and only if) the pair is still
-//! approaching. Plain functions over plain data.
+//! The narrow phase for one pair, as plain functions over plain data: the contact normal, the
+//! restitution impulse ([`apply_impulse`], the one impulse every solver applies) and, for the
+//! discrete solvers, [`resolve_contact`]: positional separation along the normal split by
+//! inverse mass, then the impulse if (and only if) the pair is still approaching.
 
 use bevy::math::DVec2;
 
-/// One circle as the contact kernel sees it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Body {
-    /// Centre.
-    pub position: DVec2,
-    /// Velocity.
-    pub velocity: DVec2,
-    /// Radius.
-    pub radius: f64,
-    /// `1 / mass`; zero for an immovable circle.
-    pub inv_mass: f64,
-}
+use crate::circle::CircleState;
 
 /// What [`resolve_contact`] did to a pair.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -27,52 +17,86 @@ pub struct ContactOutcome {
     pub impulse: f64,
 }
 
-/// The contact normal from `a` to `b`. Coincident centres have no direction of their own; they
-/// get one from the relative velocity, or `+x` if that is zero too, so no NaN can arise.
-pub fn contact_normal(a: &Body, b: &Body) -> (DVec2, f64) {
-    let d = b.position - a.position;
+/// The unit contact normal along `d` (from the first circle to the second) and `|d|`.
+/// Coincident centres have no direction of their own; they get one from `closing` (the first
+/// circle's velocity relative to the second), or `+x` if that is zero too, so no NaN can arise.
+#[inline]
+pub fn contact_normal(d: DVec2, closing: DVec2) -> (DVec2, f64) {
     let dist = d.length();
     if dist > 0.0 && dist.is_finite() {
         return (d / dist, dist);
     }
-    let closing = a.velocity - b.velocity;
     (closing.try_normalize().unwrap_or(DVec2::X), 0.0)
 }
 
-/// Resolves one pair in place if it overlaps: separates it and applies the impulse
-/// `j = -(1 + e)(v_rel · n) / (1/m_a + 1/m_b)` when the pair approaches.
+/// Applies the restitution impulse `j = -(1 + e)(v_rel · n) / (w_a + w_b)` along the normal `n`
+/// (from `a` to `b`) to velocities `va`, `vb` of inverse masses `wa`, `wb`, if the pair
+/// approaches and can move. Returns `j`, or `None` if nothing was applied.
 ///
-/// With `restitution = 1` the impulse conserves kinetic energy and momentum exactly (up to
-/// rounding); separation moves positions only, so it changes neither.
-pub fn resolve_contact(a: &mut Body, b: &mut Body, restitution: f64) -> ContactOutcome {
+/// With `restitution = 1` it conserves kinetic energy and momentum exactly (up to rounding).
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::collide::contact::apply_impulse;
+///
+/// let (mut va, mut vb) = (DVec2::new(1.0, 0.0), DVec2::new(-2.0, 0.0));
+/// let j = apply_impulse(DVec2::X, &mut va, &mut vb, 1.0, 1.0, 1.0);
+/// assert_eq!(j, Some(3.0));
+/// assert_eq!((va, vb), (DVec2::new(-2.0, 0.0), DVec2::new(1.0, 0.0))); // equal masses swap
+/// ```
+#[inline]
+pub fn apply_impulse(
+    n: DVec2,
+    va: &mut DVec2,
+    vb: &mut DVec2,
+    wa: f64,
+    wb: f64,
+    restitution: f64,
+) -> Option<f64> {
+    let approach = (*vb - *va).dot(n);
+    let w = wa + wb;
+    if !(approach < 0.0 && w > 0.0) {
+        return None;
+    }
+    let impulse = -(1.0 + restitution) * approach / w;
+    *va -= n * (impulse * wa);
+    *vb += n * (impulse * wb);
+    Some(impulse)
+}
+
+/// Resolves one pair in place if it overlaps: separates it along the normal (split by inverse
+/// mass) and applies [`apply_impulse`] when the pair approaches. `b` must be the image nearest
+/// to `a` on a periodic arena.
+///
+/// Separation moves positions only, so with `restitution = 1` neither kinetic energy nor
+/// momentum changes beyond rounding.
+pub fn resolve_contact(
+    a: &mut CircleState,
+    b: &mut CircleState,
+    restitution: f64,
+) -> ContactOutcome {
     let reach = a.radius + b.radius;
     if a.position.distance_squared(b.position) >= reach * reach {
         return ContactOutcome::default();
     }
-    let total_inv_mass = a.inv_mass + b.inv_mass;
-    let (n, dist) = contact_normal(a, b);
+    let (wa, wb) = (a.inv_mass(), b.inv_mass());
+    let total_inv_mass = wa + wb;
+    let (n, dist) = contact_normal(b.position - a.position, a.velocity - b.velocity);
     let overlap = reach - dist;
-    let outcome_penetration = overlap / a.radius.min(b.radius);
+    let penetration = overlap / a.radius.min(b.radius);
     if total_inv_mass <= 0.0 {
         // Two immovable circles: nothing can move.
         return ContactOutcome {
-            penetration: outcome_penetration,
+            penetration,
             impulse: 0.0,
         };
     }
-    a.position -= n * (overlap * a.inv_mass / total_inv_mass);
-    b.position += n * (overlap * b.inv_mass / total_inv_mass);
-
-    let approach = (b.velocity - a.velocity).dot(n);
-    let mut impulse = 0.0;
-    if approach < 0.0 {
-        impulse = -(1.0 + restitution) * approach / total_inv_mass;
-        a.velocity -= n * (impulse * a.inv_mass);
-        b.velocity += n * (impulse * b.inv_mass);
-    }
+    a.position -= n * (overlap * wa / total_inv_mass);
+    b.position += n * (overlap * wb / total_inv_mass);
+    let impulse = apply_impulse(n, &mut a.velocity, &mut b.velocity, wa, wb, restitution);
     ContactOutcome {
-        penetration: outcome_penetration,
-        impulse,
+        penetration,
+        impulse: impulse.unwrap_or(0.0),
     }
 }
 
@@ -80,13 +104,8 @@ pub fn resolve_contact(a: &mut Body, b: &mut Body, restitution: f64) -> ContactO
 mod tests {
     use super::*;
 
-    fn body(x: f64, y: f64, vx: f64, vy: f64) -> Body {
-        Body {
-            position: DVec2::new(x, y),
-            velocity: DVec2::new(vx, vy),
-            radius: 0.5,
-            inv_mass: 1.0,
-        }
+    fn body(x: f64, y: f64, vx: f64, vy: f64) -> CircleState {
+        CircleState::new(DVec2::new(x, y), DVec2::new(vx, vy), 0.5)
     }
 
     #[test]
@@ -125,13 +144,22 @@ mod tests {
 
     #[test]
     fn an_immovable_circle_does_not_move() {
-        let mut wall = body(0.0, 0.0, 0.0, 0.0);
-        wall.inv_mass = 0.0;
+        let mut wall = body(0.0, 0.0, 0.0, 0.0).with_mass(f64::INFINITY);
         let mut ball = body(0.8, 0.0, -3.0, 0.0);
         resolve_contact(&mut wall, &mut ball, 1.0);
         assert_eq!(wall.position, DVec2::ZERO);
         assert_eq!(wall.velocity, DVec2::ZERO);
         assert_eq!(ball.velocity, DVec2::new(3.0, 0.0));
         assert!((ball.position.x - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn two_immovable_circles_get_no_impulse() {
+        let (mut va, mut vb) = (DVec2::X, -DVec2::X);
+        assert_eq!(
+            apply_impulse(DVec2::X, &mut va, &mut vb, 0.0, 0.0, 1.0),
+            None
+        );
+        assert_eq!((va, vb), (DVec2::X, -DVec2::X));
     }
 }

@@ -7,7 +7,8 @@
 //!   past the bound the rest of the step is free flight and the missed hits resolve next step.
 //!
 //! Both handle walls, periodic edges and collisions themselves, so they run in the
-//! [`ContinuousStep`](crate::schedule::ContinuousStep) schedule after the force effects.
+//! [`ContinuousStep`] schedule after the force effects, as three systems: gather the circles
+//! into the engine (rebuilding it if needed), advance it by the step, write the circles back.
 
 pub mod engine;
 pub mod queue;
@@ -16,11 +17,14 @@ pub mod toi;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::arena::Arena;
+use crate::boundary::WallCollisions;
+use crate::circle::CircleState;
+use crate::collide::PairCollisions;
 use crate::components::{Mass, Position, Radius, Velocity};
-use crate::config::{Arena, Boundary, Effects, Solver};
-use crate::diagnostics::CollisionCounters;
+use crate::config::{Effects, Solver};
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
-use engine::{Bounds, Circle, EventEngine, EventStats};
+use engine::{EventEngine, EventStats};
 
 /// Events a `swept` step may process per circle before the rest of the step is free flight.
 pub const SWEPT_EVENTS_PER_CIRCLE: u64 = 64;
@@ -33,10 +37,15 @@ pub struct ContinuousPlugin;
 
 impl Plugin for ContinuousPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<EngineState>().add_systems(
-            ContinuousStep,
-            advance_continuous.in_set(CircleSystems::Continuous),
-        );
+        app.init_resource::<EngineState>()
+            .init_resource::<PairCollisions>()
+            .init_resource::<WallCollisions>()
+            .add_systems(
+                ContinuousStep,
+                (gather_into_engine, advance_engine, write_back)
+                    .chain()
+                    .in_set(CircleSystems::Continuous),
+            );
     }
 }
 
@@ -55,30 +64,28 @@ pub struct EngineState {
     pub rebuilds: u64,
 }
 
-/// The engine's view of the arena.
-pub fn bounds_of(arena: &Arena, boundary: Boundary) -> Bounds {
-    match boundary {
-        Boundary::Walls => Bounds::Walls {
-            min: arena.min,
-            max: arena.max,
-        },
-        Boundary::Periodic => Bounds::Periodic {
-            min: arena.min,
-            size: arena.size(),
-        },
-    }
-}
+/// The circles as the continuous step reads and writes them, in one query type so that every
+/// system of the step sees them in the same order.
+type Circles<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static mut Position,
+        &'static mut Velocity,
+        &'static Radius,
+        &'static Mass,
+    ),
+>;
 
-/// Advances one step with the `swept` or `exact` solver.
-#[allow(clippy::too_many_arguments)]
-pub fn advance_continuous(
+/// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
+/// step; otherwise (and always for `swept`) builds a fresh one from the circles.
+fn gather_into_engine(
     solver: Res<Solver>,
     arena: Res<Arena>,
     effects: Res<Effects>,
-    dt: Res<StepDt>,
-    mut counters: ResMut<CollisionCounters>,
     mut state: ResMut<EngineState>,
-    mut circles: Query<(Entity, &mut Position, &mut Velocity, &Radius, &Mass)>,
+    circles: Circles,
 ) {
     let state = &mut *state;
     let setup = (*arena, *effects, *solver);
@@ -90,29 +97,38 @@ pub fn advance_continuous(
             .iter()
             .zip(state.entities.iter().zip(&state.written))
             .all(|((e, p, v, _, _), (&we, &(wp, wv)))| e == we && p.0 == wp && v.0 == wv);
-    if !unchanged {
-        let bodies: Vec<Circle> = circles
-            .iter()
-            .map(|(_, p, v, r, m)| Circle {
-                position: p.0,
-                velocity: v.0,
-                radius: r.0,
-                inv_mass: m.inverse(),
-            })
-            .collect();
-        let engine = EventEngine::new(
-            &bodies,
-            bounds_of(&arena, effects.boundary),
-            effects.restitution,
-            effects.wall_restitution,
-        );
-        state.last_stats = engine.stats();
-        state.engine = Some(engine);
-        state.entities = circles.iter().map(|(e, ..)| e).collect();
-        state.setup = Some(setup);
-        state.rebuilds += 1;
+    if unchanged {
+        return;
     }
-    let engine = state.engine.as_mut().expect("built above");
+    let bodies: Vec<CircleState> = circles
+        .iter()
+        .map(|(_, p, v, r, m)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
+        .collect();
+    let engine = EventEngine::new(
+        &bodies,
+        &arena,
+        effects.restitution,
+        effects.wall_restitution,
+    );
+    state.last_stats = engine.stats();
+    state.engine = Some(engine);
+    state.entities = circles.iter().map(|(e, ..)| e).collect();
+    state.setup = Some(setup);
+    state.rebuilds += 1;
+}
+
+/// Processes the step's events (within the solver's budget) and counts what they did.
+fn advance_engine(
+    solver: Res<Solver>,
+    dt: Res<StepDt>,
+    mut state: ResMut<EngineState>,
+    mut pairs: ResMut<PairCollisions>,
+    mut walls: ResMut<WallCollisions>,
+) {
+    let state = &mut *state;
+    let Some(engine) = state.engine.as_mut() else {
+        return;
+    };
     let per_circle = match *solver {
         Solver::Swept => SWEPT_EVENTS_PER_CIRCLE,
         _ => EXACT_EVENTS_PER_CIRCLE,
@@ -123,14 +139,21 @@ pub fn advance_continuous(
         engine.drift_to(t_end);
         state.budget_exhausted += 1;
     }
-
     let stats = engine.stats();
     let last = std::mem::replace(&mut state.last_stats, stats);
-    counters.pair_collisions += stats.pair_collisions - last.pair_collisions;
-    counters.wall_collisions += stats.wall_collisions - last.wall_collisions;
-    counters.wall_impulse += stats.wall_impulse - last.wall_impulse;
-    counters.virial += stats.virial - last.virial;
+    pairs.count += stats.pair_collisions - last.pair_collisions;
+    pairs.virial += stats.virial - last.virial;
+    walls.count += stats.wall_collisions - last.wall_collisions;
+    walls.impulse += stats.wall_impulse - last.wall_impulse;
+}
 
+/// Writes the engine's positions and velocities back to the circles that changed, and
+/// remembers what it wrote.
+fn write_back(mut state: ResMut<EngineState>, mut circles: Circles) {
+    let state = &mut *state;
+    let Some(engine) = state.engine.as_ref() else {
+        return;
+    };
     state.written.clear();
     for (i, (_, mut p, mut v, _, _)) in circles.iter_mut().enumerate() {
         let (position, velocity) = (engine.position(i), engine.velocity(i));

@@ -1,16 +1,21 @@
 //! The heads-up display, refreshed twice a second: circle count, solver, steps per second,
 //! energy drift since the last reset and collisions per second; then pressure (virial and
-//! walls), momentum, overlaps, escapes and non-finite values. `h` toggles the help.
+//! walls), momentum, overlaps, escapes and non-finite values. `h` toggles the key help.
+//!
+//! [`HudRates`] measures the rates over each refresh window; [`hud_text`] writes the two lines
+//! from what the diagnostics hold, as a plain function.
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
-use bevy::math::DVec2;
-
-use crate::collide::collision_space;
+use crate::arena::Arena;
+use crate::boundary::WallCollisions;
+use crate::collide::PairCollisions;
+use crate::collide::overlaps::Overlaps;
 use crate::components::{Position, Radius};
-use crate::config::{Arena, Boundary, Effects, Solver};
-use crate::diagnostics::{CircleDiagnostics, CollisionCounters, Overlaps, Pressure};
-use crate::spawn::CircleInit;
+use crate::config::Solver;
+use crate::diagnostics::{CircleDiagnostics, Pressure};
+use crate::schedule::StepTotals;
 
 /// The HUD text and the help overlay.
 #[derive(Clone, Copy, Debug, Default)]
@@ -19,8 +24,19 @@ pub struct HudPlugin;
 impl Plugin for HudPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<HelpVisible>()
+            .init_resource::<HudRates>()
             .add_systems(Startup, spawn_hud)
-            .add_systems(Update, (update_hud, show_help));
+            .add_systems(
+                Update,
+                (
+                    (
+                        measure_rates,
+                        update_hud.run_if(resource_changed::<HudRates>),
+                    )
+                        .chain(),
+                    show_help,
+                ),
+            );
     }
 }
 
@@ -28,8 +44,9 @@ impl Plugin for HudPlugin {
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct HelpVisible(pub bool);
 
+/// Marks the HUD's text.
 #[derive(Component)]
-struct HudText;
+pub struct HudText;
 
 #[derive(Component)]
 struct HelpText;
@@ -79,77 +96,71 @@ fn spawn_hud(mut commands: Commands) {
     ));
 }
 
-/// Rates measured over the last refresh window of real time.
-#[derive(Default)]
-struct RateWindow {
+/// Steps and collisions per second of real time, over the last refresh window. Changes only
+/// when a window completes, which is when the HUD redraws.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct HudRates {
     since: f64,
     steps: u64,
     collisions: u64,
-    steps_per_second: f64,
-    collisions_per_second: f64,
+    /// Fixed steps per second.
+    pub steps_per_second: f64,
+    /// Circle and wall collisions per second.
+    pub collisions_per_second: f64,
 }
 
-const REFRESH_SECONDS: f64 = 0.5;
+/// Seconds of real time between HUD refreshes.
+pub const REFRESH_SECONDS: f64 = 0.5;
 
-/// The HUD's second line: pressure both ways, overlaps, escapes and non-finite values.
-fn physics_line(
-    diagnostics: &CircleDiagnostics,
-    counters: &CollisionCounters,
-    arena: &Arena,
-    effects: &Effects,
-    overlaps: &Overlaps,
-) -> String {
-    let walls = effects.boundary == Boundary::Walls;
-    let p = Pressure::measure(
-        counters,
-        diagnostics.count,
-        diagnostics.kinetic_energy,
-        arena,
-        walls,
-    );
-    let z = |z: Option<f64>| z.map_or("-".to_owned(), |z| format!("{z:.3}"));
-    format!(
-        "pressure z {} (walls {})   momentum ({:+.3e}, {:+.3e})   overlap max {:.3} mean {:.3} r   escaped {}   non-finite {}",
-        z(p.z_virial),
-        z(p.z_wall),
-        diagnostics.momentum.x,
-        diagnostics.momentum.y,
-        overlaps.max,
-        if overlaps.pairs == 0 {
-            0.0
-        } else {
-            overlaps.sum / overlaps.pairs as f64
-        },
-        diagnostics.escaped,
-        diagnostics.non_finite,
-    )
+/// What the simulation measured, as the HUD reads it.
+#[derive(SystemParam)]
+pub struct Measured<'w> {
+    diagnostics: Res<'w, CircleDiagnostics>,
+    elapsed: Res<'w, StepTotals>,
+    pairs: Res<'w, PairCollisions>,
+    walls: Res<'w, WallCollisions>,
+    arena: Res<'w, Arena>,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn update_hud(
-    real: Res<Time<Real>>,
-    virt: Res<Time<Virtual>>,
-    solver: Res<Solver>,
-    arena: Res<Arena>,
-    effects: Res<Effects>,
-    diagnostics: Res<CircleDiagnostics>,
-    counters: Res<CollisionCounters>,
-    circles: Query<(&Position, &Radius)>,
-    mut window: Local<RateWindow>,
-    mut text: Single<&mut Text, With<HudText>>,
-) {
+fn measure_rates(real: Res<Time<Real>>, measured: Measured, mut rates: ResMut<HudRates>) {
     let now = real.elapsed_secs_f64();
-    let elapsed = now - window.since;
-    let collisions = counters.pair_collisions + counters.wall_collisions;
-    if elapsed < REFRESH_SECONDS && window.since > 0.0 {
+    let elapsed = now - rates.since;
+    if elapsed < REFRESH_SECONDS && rates.since > 0.0 {
         return;
     }
+    let steps = measured.elapsed.steps;
+    let collisions = measured.pairs.count + measured.walls.count;
+    let window = elapsed.max(f64::MIN_POSITIVE);
     // Counters restart at a reset; a window that spans one shows zero rather than nonsense.
-    window.steps_per_second = counters.steps.saturating_sub(window.steps) as f64 / elapsed;
-    window.collisions_per_second = collisions.saturating_sub(window.collisions) as f64 / elapsed;
-    window.since = now;
-    window.steps = counters.steps;
-    window.collisions = collisions;
+    *rates = HudRates {
+        since: now,
+        steps,
+        collisions,
+        steps_per_second: steps.saturating_sub(rates.steps) as f64 / window,
+        collisions_per_second: collisions.saturating_sub(rates.collisions) as f64 / window,
+    };
+}
+
+fn update_hud(
+    virt: Res<Time<Virtual>>,
+    solver: Res<Solver>,
+    measured: Measured,
+    rates: Res<HudRates>,
+    circles: Query<(&Position, &Radius)>,
+    mut text: Single<&mut Text, With<HudText>>,
+) {
+    // Overlaps are measured here, at the HUD's refresh rate, not every step.
+    let discs: Vec<_> = circles.iter().map(|(p, r)| (p.0, r.0)).collect();
+    let overlaps = Overlaps::measure(&discs, &measured.arena);
+    let d = &*measured.diagnostics;
+    let pressure = Pressure::measure(
+        &measured.elapsed,
+        &measured.pairs,
+        &measured.walls,
+        d.count,
+        d.kinetic_energy,
+        &measured.arena,
+    );
     let state = if virt.is_paused() {
         "  PAUSED".to_owned()
     } else if virt.relative_speed() != 1.0 {
@@ -157,28 +168,37 @@ fn update_hud(
     } else {
         String::new()
     };
-    // Overlaps are measured here, at the HUD's refresh rate, not every step.
-    let snapshot: Vec<CircleInit> = circles
-        .iter()
-        .map(|(p, r)| CircleInit {
-            position: p.0,
-            velocity: DVec2::ZERO,
-            radius: r.0,
-            mass: 1.0,
-            tint: [0; 3],
-        })
-        .collect();
-    let overlaps = Overlaps::measure(&snapshot, collision_space(&arena, effects.boundary));
-    text.0 = format!(
-        "circles {}   solver {}   {:.0} steps/s   energy drift {:+.2e}   {:.0} collisions/s{}   (h: help)\n{}",
-        diagnostics.count,
-        *solver,
-        window.steps_per_second,
-        diagnostics.energy_drift(),
-        window.collisions_per_second,
-        state,
-        physics_line(&diagnostics, &counters, &arena, &effects, &overlaps),
-    );
+    text.0 = hud_text(d, *solver, &rates, &pressure, &overlaps, &state);
+}
+
+/// The HUD's two lines: counts, cost and conservation; then pressure both ways, momentum,
+/// overlaps, escapes and non-finite values. `state` is appended to the first line (pause,
+/// speed).
+pub fn hud_text(
+    d: &CircleDiagnostics,
+    solver: Solver,
+    rates: &HudRates,
+    pressure: &Pressure,
+    overlaps: &Overlaps,
+    state: &str,
+) -> String {
+    let z = |z: Option<f64>| z.map_or("-".to_owned(), |z| format!("{z:.3}"));
+    format!(
+        "circles {}   solver {solver}   {:.0} steps/s   energy drift {:+.2e}   {:.0} collisions/s{state}   (h: help)\n\
+         pressure z {} (walls {})   momentum ({:+.3e}, {:+.3e})   overlap max {:.3} mean {:.3} r   escaped {}   non-finite {}",
+        d.count,
+        rates.steps_per_second,
+        d.energy_drift(),
+        rates.collisions_per_second,
+        z(pressure.z_virial),
+        z(pressure.z_wall),
+        d.momentum.x,
+        d.momentum.y,
+        overlaps.max,
+        overlaps.mean(),
+        d.escaped,
+        d.non_finite,
+    )
 }
 
 fn show_help(

@@ -13,8 +13,8 @@ use bevy::camera::ScalingMode;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 
+use crate::arena::Arena;
 use crate::components::{Position, Radius, Tint};
-use crate::config::Arena;
 
 /// Everything the window shows: arena, circles, HUD and the keyboard and mouse controls.
 #[derive(Clone, Copy, Debug, Default)]
@@ -169,7 +169,7 @@ pub fn display_problem() -> Option<String> {
 }
 
 /// What to tell a user whose machine cannot open the window.
-pub const NO_WINDOW_HINT: &str = "moving_circles: cannot open a window here (no display, or no \
+pub const NO_WINDOW_HINT: &str = "cannot open a window here (no display, or no \
 Vulkan/GL driver). Use the headless commands instead (`moving_circles run --help`), or run the \
 app under a virtual display: `xvfb-run -a moving_circles` (Debian packages: xvfb, xauth, \
 mesa-vulkan-drivers).";

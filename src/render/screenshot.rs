@@ -1,11 +1,13 @@
-//! `--screenshot PATH --frames N`: render N frames, save the window to a PNG (written to a
-//! temporary file and renamed, so a half-written picture never appears) and exit, so the app can
-//! be checked without a person.
+//! `--screenshot PATH --frames N`: render N frames, save the window to a PNG (written
+//! atomically, so a half-written picture never appears) and exit, so the app can be checked
+//! without a person.
 
 use std::path::PathBuf;
 
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+
+use crate::io::write_atomically;
 
 /// Takes one screenshot after `frames` frames, then exits (with an error code if saving failed).
 #[derive(Clone, Debug)]
@@ -61,8 +63,8 @@ fn save_png(image: &Image, path: &std::path::Path) -> Result<(), String> {
         .try_into_dynamic()
         .map_err(|e| e.to_string())?
         .to_rgb8();
-    let tmp = path.with_extension("png.partial");
-    rgb.save_with_format(&tmp, image::ImageFormat::Png)
+    let mut png = std::io::Cursor::new(Vec::new());
+    rgb.write_to(&mut png, image::ImageFormat::Png)
         .map_err(|e| e.to_string())?;
-    std::fs::rename(&tmp, path).map_err(|e| e.to_string())
+    write_atomically(path, png.get_ref()).map_err(|e| e.to_string())
 }

@@ -9,9 +9,12 @@ use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoadFailedEvent, AssetLoader, LoadContext};
 use bevy::prelude::*;
 
-use super::{InputError, Scene};
-use crate::config::{Arena, CirclesConfig, Effects, Solver, SpawnConfig};
+use super::schema::Scene;
+use crate::arena::Arena;
+use crate::config::{CirclesConfig, Effects, Solver, SpawnConfig};
 use crate::effects::reconcile_effects;
+use crate::error::InputError;
+use crate::schedule::allow_long_steps;
 use crate::spawn::{FixedCircles, Respawn};
 
 /// A scene file, checked and turned into a configuration.
@@ -64,8 +67,8 @@ pub fn apply_config(world: &mut World, config: &CirclesConfig) {
     world
         .resource_mut::<Time<Fixed>>()
         .set_timestep(Duration::from_secs_f64(config.dt));
-    let _ = world.run_system_cached(crate::schedule::allow_long_steps);
-    reconcile_effects(world, &config.effects);
+    let _ = world.run_system_cached(allow_long_steps);
+    reconcile_effects(world);
     world.write_message(Respawn);
 }
 

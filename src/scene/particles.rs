@@ -1,32 +1,21 @@
 //! The plain-text particle format of the Princeton event-driven collision demo: first line `N`,
 //! then one line per circle `rx ry vx vy radius mass r g b` (colour bytes 0-255), in the unit
 //! square `[0, 1]²`. Read exactly — every problem names its line — and written back exactly
-//! (shortest round-trip decimal for each number), atomically.
+//! (shortest round-trip decimal for each number).
 
-use std::io::Write;
 use std::path::Path;
 
 use bevy::math::DVec2;
-use bevy::prelude::*;
 
-use super::{InputError, check_circle, first_overlap};
-use crate::config::{Arena, Boundary};
-use crate::spawn::CircleInit;
-
-/// The arena of the particle format.
-pub fn unit_square() -> Arena {
-    Arena {
-        min: DVec2::ZERO,
-        max: DVec2::ONE,
-    }
-}
-
-/// Most circles a particle file may declare (bounds memory before anything is read).
-pub const MAX_PARTICLES: usize = 20_000_000;
+use super::check::{check_circle, first_overlap};
+use crate::arena::{Arena, Boundary};
+use crate::circle::CircleState;
+use crate::config::{CirclesConfig, MAX_CIRCLES, SpawnConfig};
+use crate::error::InputError;
 
 /// Reads a particle file's text. `origin` names it in errors. Circles must lie inside the unit
 /// square (with walls: entirely; periodic: their centres) and must not overlap beyond rounding.
-pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleInit>, InputError> {
+pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleState>, InputError> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim()));
     let (header_line, header) = lines.by_ref().find(|(_, l)| !l.is_empty()).ok_or_else(|| {
         InputError::whole(
@@ -41,14 +30,14 @@ pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleI
             format!("expected the number of circles, got `{header}`"),
         )
     })?;
-    if n > MAX_PARTICLES {
+    if n > MAX_CIRCLES {
         return Err(InputError::line(
             origin,
             header_line,
-            format!("declares {n} circles; at most {MAX_PARTICLES} are supported"),
+            format!("declares {n} circles; at most {MAX_CIRCLES} are supported"),
         ));
     }
-    let arena = unit_square();
+    let arena = Arena::unit_square(boundary);
     // Capacity grows with what is actually read, not with what the header claims.
     let mut circles = Vec::with_capacity(n.min(1 << 16));
     let mut line_of = Vec::with_capacity(n.min(1 << 16));
@@ -64,9 +53,8 @@ pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleI
             ));
         }
         let circle = parse_circle(line).map_err(|m| InputError::line(origin, number, m))?;
-        check_circle(&circle, &arena, boundary).map_err(|(field, message)| {
-            InputError::line(origin, number, format!("{field} {message}"))
-        })?;
+        check_circle(&circle, &arena)
+            .map_err(|e| InputError::line(origin, number, format!("{} {}", e.field, e.message)))?;
         circles.push(circle);
         line_of.push(number);
     }
@@ -79,7 +67,7 @@ pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleI
             ),
         ));
     }
-    if let Some((i, j, depth)) = first_overlap(&circles, boundary, &arena) {
+    if let Some((i, j, depth)) = first_overlap(&circles, &arena) {
         return Err(InputError::line(
             origin,
             line_of[j],
@@ -94,7 +82,7 @@ pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleI
 
 const FIELDS: [&str; 9] = ["rx", "ry", "vx", "vy", "radius", "mass", "r", "g", "b"];
 
-fn parse_circle(line: &str) -> Result<CircleInit, String> {
+fn parse_circle(line: &str) -> Result<CircleState, String> {
     let words: Vec<&str> = line.split_whitespace().collect();
     if words.len() != FIELDS.len() {
         return Err(format!(
@@ -119,7 +107,7 @@ fn parse_circle(line: &str) -> Result<CircleInit, String> {
             .parse()
             .map_err(|_| format!("{} must be an integer 0-255, got `{word}`", FIELDS[6 + k]))?;
     }
-    Ok(CircleInit {
+    Ok(CircleState {
         position: DVec2::new(x[0], x[1]),
         velocity: DVec2::new(x[2], x[3]),
         radius: x[4],
@@ -129,7 +117,7 @@ fn parse_circle(line: &str) -> Result<CircleInit, String> {
 }
 
 /// Reads a particle file.
-pub fn read(path: &Path, boundary: Boundary) -> Result<Vec<CircleInit>, InputError> {
+pub fn read(path: &Path, boundary: Boundary) -> Result<Vec<CircleState>, InputError> {
     let origin = path.display().to_string();
     let text = std::fs::read_to_string(path)
         .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
@@ -137,7 +125,7 @@ pub fn read(path: &Path, boundary: Boundary) -> Result<Vec<CircleInit>, InputErr
 }
 
 /// The particle-format text of `circles`.
-pub fn format(circles: &[CircleInit]) -> String {
+pub fn format(circles: &[CircleState]) -> String {
     let mut out = format!("{}\n", circles.len());
     for c in circles {
         let [r, g, b] = c.tint;
@@ -149,28 +137,18 @@ pub fn format(circles: &[CircleInit]) -> String {
     out
 }
 
-/// Writes `text` to `path` atomically: to a temporary file beside it, then renamed over it, so a
-/// reader never sees half a file and a failed write leaves the old one intact.
-pub fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
-    let result = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(text.as_bytes())?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+/// What a particle file runs as: its circles in the unit square with this `boundary`, no
+/// random circles, the default effects, solver and step.
+pub fn to_config(circles: Vec<CircleState>, boundary: Boundary) -> CirclesConfig {
+    CirclesConfig {
+        arena: Arena::unit_square(boundary),
+        spawn: SpawnConfig {
+            count: 0,
+            ..SpawnConfig::default()
+        },
+        circles,
+        ..CirclesConfig::default()
     }
-    result
 }
 
 #[cfg(test)]
@@ -260,21 +238,5 @@ mod tests {
         // 0.1 + 0.2 is not exactly representable: the centres are 2r apart up to rounding.
         let text = "2\n0.1 0.5 0 0 0.1 1 0 0 0\n0.3 0.5 0 0 0.1 1 0 0 0\n";
         assert_eq!(parse(text, "t", Boundary::Walls).unwrap().len(), 2);
-    }
-
-    #[test]
-    fn atomic_write_replaces_the_file_whole() {
-        let dir = std::env::temp_dir().join(format!("mc-atomic-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("out.txt");
-        write_atomically(&path, "first").unwrap();
-        write_atomically(&path, "second").unwrap();
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), "second");
-        assert_eq!(
-            std::fs::read_dir(&dir).unwrap().count(),
-            1,
-            "no temporary file left behind"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

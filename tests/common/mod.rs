@@ -27,17 +27,27 @@ pub fn empty(config: CirclesConfig) -> CirclesConfig {
 
 /// Runs `n` fixed steps and checks the app really advanced that many.
 pub fn step(app: &mut App, n: u64) {
-    let before = app.world().resource::<CollisionCounters>().steps;
+    let before = app.world().resource::<StepTotals>().steps;
     for _ in 0..n {
         app.update();
     }
-    let after = app.world().resource::<CollisionCounters>().steps;
+    let after = app.world().resource::<StepTotals>().steps;
     assert_eq!(
         after - before,
         n,
         "expected {n} fixed steps, the app ran {}",
         after - before
     );
+}
+
+/// Circle-circle collisions since the last (re)spawn.
+pub fn pair_collisions(app: &App) -> u64 {
+    app.world().resource::<PairCollisions>().count
+}
+
+/// Wall hits since the last (re)spawn.
+pub fn wall_collisions(app: &App) -> u64 {
+    app.world().resource::<WallCollisions>().count
 }
 
 /// Spawns one circle.
@@ -56,6 +66,63 @@ pub fn spawn_circle(
             Mass(mass),
         ))
         .id()
+}
+
+/// Two equal unit-mass circles on the x axis at `∓x`, each moving towards the other at `speed`.
+pub fn spawn_head_on(app: &mut App, x: f64, speed: f64, radius: f64) -> (Entity, Entity) {
+    (
+        spawn_circle(
+            app,
+            DVec2::new(-x, 0.0),
+            DVec2::new(speed, 0.0),
+            radius,
+            1.0,
+        ),
+        spawn_circle(
+            app,
+            DVec2::new(x, 0.0),
+            DVec2::new(-speed, 0.0),
+            radius,
+            1.0,
+        ),
+    )
+}
+
+/// Asserts that a circle at `p` of radius `r` lies entirely inside `arena`.
+pub fn assert_inside(arena: &Arena, p: DVec2, r: f64, what: &str) {
+    assert!(
+        p.x - r >= arena.min.x
+            && p.x + r <= arena.max.x
+            && p.y - r >= arena.min.y
+            && p.y + r <= arena.max.y,
+        "{what} at {p} with radius {r} is not inside {arena:?}"
+    );
+}
+
+/// Circles for the unit box from random `(x, y, vx, vy, r, m)` tuples, keeping each that lies
+/// inside (with walls) and clear of the ones kept before it (by the minimum image when
+/// periodic); and the box.
+pub fn unit_box_gas(
+    seeds: &[(f64, f64, f64, f64, f64, f64)],
+    periodic: bool,
+) -> (Vec<CircleState>, Arena) {
+    let arena = Arena::unit_square(if periodic {
+        Boundary::Periodic
+    } else {
+        Boundary::Walls
+    });
+    let mut circles: Vec<CircleState> = Vec::new();
+    for &(x, y, vx, vy, r, m) in seeds {
+        let p = DVec2::new(x, y);
+        let clear = circles
+            .iter()
+            .all(|c| arena.offset(c.position, p).length() > c.radius + r);
+        let inside = periodic || (r..=1.0 - r).contains(&x) && (r..=1.0 - r).contains(&y);
+        if clear && inside {
+            circles.push(CircleState::new(p, DVec2::new(vx, vy), r).with_mass(m));
+        }
+    }
+    (circles, arena)
 }
 
 /// `(position, velocity)` of a circle.

@@ -1,0 +1,75 @@
+//! The accuracy study behind `moving_circles accuracy`: the same scenes under every solver and
+//! setting, each measured against the `exact` solver (the reference) and timed, to show what
+//! accuracy costs.
+//!
+//! - [`measure`]: one run ([`trace`]) and its comparison with the reference ([`compare`]);
+//! - [`report`]: the rows as CSV and as a table;
+//! - [`plot`]: the figure;
+//! - [`auto`]: `--solver auto`, the cheapest solver within a tolerance on the user's scene.
+
+pub mod auto;
+pub mod measure;
+pub mod plot;
+pub mod report;
+
+use std::path::Path;
+
+pub use measure::{Case, HORIZON_SECONDS, Row, SOLVERS, Trace, compare, passed_through, trace};
+
+use crate::config::Solver;
+use crate::error::InputError;
+use crate::scene::Scene;
+
+/// The solvers and steps every case is run with: one step size when `quick`.
+pub fn settings(quick: bool) -> Vec<(Solver, f64)> {
+    let dts: &[f64] = if quick {
+        &[1.0 / 60.0]
+    } else {
+        &[1.0 / 30.0, 1.0 / 60.0, 1.0 / 120.0]
+    };
+    dts.iter()
+        .flat_map(|&dt| SOLVERS.iter().map(move |&s| (s, dt)))
+        .collect()
+}
+
+/// The study's cases (gas1k, gas, billiards, fast), from the scene files in `scenes_dir`;
+/// shorter runs when `quick`.
+pub fn default_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputError> {
+    // Billiards is compared after the break (the cue ball reaches the rack at about 0.21 s).
+    let plan = [
+        ("gas1k", 5.0, 1.0, HORIZON_SECONDS),
+        ("gas", 2.0, 0.5, HORIZON_SECONDS),
+        ("billiards", 2.0, 1.0, 0.3),
+        ("fast", 2.0, 0.5, HORIZON_SECONDS),
+    ];
+    plan.into_iter()
+        .map(|(name, seconds, quick_seconds, horizon)| {
+            Ok(Case {
+                name: name.to_owned(),
+                config: Scene::load(&scenes_dir.join(format!("{name}.ron")))?,
+                seconds: if quick { quick_seconds } else { seconds },
+                horizon,
+            })
+        })
+        .collect()
+}
+
+/// Runs every case under every setting and compares each run with the case's `exact`
+/// reference at 60 Hz. `progress(case, setting)` is told what runs next (`None`: the
+/// reference).
+pub fn study(
+    cases: &[Case],
+    settings: &[(Solver, f64)],
+    mut progress: impl FnMut(&Case, Option<(Solver, f64)>),
+) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for case in cases {
+        progress(case, None);
+        let reference = trace(case, Solver::Exact, 1.0 / 60.0);
+        for &(solver, dt) in settings {
+            progress(case, Some((solver, dt)));
+            rows.push(compare(case, &trace(case, solver, dt), &reference));
+        }
+    }
+    rows
+}

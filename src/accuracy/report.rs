@@ -1,0 +1,93 @@
+//! The study's results as text: a CSV with one column per [`Row`] field (written through
+//! serde, so the columns are the struct's) and the fixed-width table the command prints.
+
+use super::measure::Row;
+
+/// The study as CSV text, a header line then one line per row.
+pub fn to_csv(rows: &[Row]) -> Result<String, csv::Error> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    for row in rows {
+        writer.serialize(row)?;
+    }
+    let bytes = writer.into_inner().map_err(|e| e.into_error())?;
+    Ok(String::from_utf8(bytes).expect("CSV of numbers and names is UTF-8"))
+}
+
+/// The study as a fixed-width table.
+pub fn to_table(rows: &[Row]) -> String {
+    let mut out = format!(
+        "{:<9} {:>6} {:<12} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>6} {:>9} {:>8}\n",
+        "scene",
+        "n",
+        "solver",
+        "1/dt",
+        "ms/step",
+        "pos err",
+        "E drift",
+        "max pen",
+        "mean pen",
+        "tunnel",
+        "coll err",
+        "z err"
+    );
+    for r in rows {
+        out.push_str(&format!(
+            "{:<9} {:>6} {:<12} {:>6.0} {:>9.3} {:>9.2e} {:>10.1e} {:>9.2e} {:>9.2e} {:>6} {:>+9.3} {:>8}\n",
+            r.scene,
+            r.n,
+            r.solver,
+            1.0 / r.dt,
+            r.ms_per_step,
+            r.position_error,
+            r.energy_drift,
+            r.max_penetration,
+            r.mean_penetration,
+            r.tunnelled,
+            r.collision_error,
+            r.z_error.map(|z| format!("{z:+.3}")).unwrap_or_else(|| "-".into()),
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_csv_has_one_column_per_field_and_empty_cells_for_missing_values() {
+        let row = Row {
+            scene: "gas".into(),
+            n: 3,
+            solver: "substeps=4".into(),
+            dt: 0.5,
+            steps: 2,
+            ms_per_step: 1.5,
+            ms_per_sim_second: 3.0,
+            horizon: 0.1,
+            position_error: 1e-3,
+            energy_drift: 0.0,
+            momentum_drift: 0.0,
+            max_penetration: 0.25,
+            mean_penetration: 0.125,
+            tunnelled: 1,
+            escaped: 0,
+            pair_collisions: 42,
+            collision_error: -0.5,
+            z: None,
+            z_error: Some(0.01),
+            speed_ks: 0.0,
+        };
+        let csv = to_csv(&[row]).unwrap();
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let cells: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(header.len(), 20);
+        assert_eq!(header.len(), cells.len());
+        let cell = |name: &str| cells[header.iter().position(|&h| h == name).unwrap()];
+        assert_eq!(cell("solver"), "substeps=4");
+        assert_eq!(cell("pair_collisions"), "42");
+        assert_eq!(cell("z"), "");
+        assert_eq!(cell("z_error"), "0.01");
+    }
+}

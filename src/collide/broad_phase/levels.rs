@@ -1,0 +1,74 @@
+//! Size levels for radii spanning decades: one grid sized for the largest circle would put
+//! thousands of small circles in each cell, so circles are split into levels by size (a factor
+//! of 4 per level), each level gets its own grid, and each circle also checks the cells of the
+//! finer levels under it.
+
+use bevy::math::DVec2;
+
+use super::cells::{CellList, radius_range};
+use super::scan::{single_level_pairs, sort_and_dedupe};
+use crate::arena::Arena;
+
+struct Level {
+    members: Vec<u32>,
+    cells: CellList,
+    max_radius: f64,
+}
+
+/// Appends every overlapping pair `(i, j)`, `i < j`, of `circles` (centre, reach), sorted, with
+/// `r_min` the smallest reach.
+pub fn multi_level_pairs(
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    r_min: f64,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    let level_of = |r: f64| ((r / r_min).log2() / 2.0).floor().max(0.0) as usize;
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    for (i, &(_, r)) in circles.iter().enumerate() {
+        let l = level_of(r);
+        if members.len() <= l {
+            members.resize(l + 1, Vec::new());
+        }
+        members[l].push(i as u32);
+    }
+    let mut levels: Vec<Level> = Vec::with_capacity(members.len());
+    let start = pairs.len();
+    for members in members {
+        let own: Vec<(DVec2, f64)> = members.iter().map(|&i| circles[i as usize]).collect();
+        let mut cells = CellList::default();
+        let mut local = Vec::new();
+        let max_radius = radius_range(&own).1;
+        single_level_pairs(&mut cells, arena, &own, max_radius, &mut local);
+        pairs.extend(local.into_iter().map(|(a, b)| {
+            let (i, j) = (members[a as usize], members[b as usize]);
+            (i.min(j), i.max(j))
+        }));
+        levels.push(Level {
+            members,
+            cells,
+            max_radius,
+        });
+    }
+    // Each circle against the finer levels: the cells its reach could touch.
+    for (m, coarse) in levels.iter().enumerate() {
+        for &a in &coarse.members {
+            let (p, r) = circles[a as usize];
+            for fine in &levels[..m] {
+                if fine.members.is_empty() {
+                    continue;
+                }
+                let reach = DVec2::splat(r + fine.max_radius);
+                fine.cells.for_each_in_box(p - reach, p + reach, |k| {
+                    let b = fine.members[fine.cells.order()[k] as usize];
+                    let (q, s) = circles[b as usize];
+                    if arena.offset(p, q).length_squared() < (r + s) * (r + s) {
+                        pairs.push((a.min(b), a.max(b)));
+                    }
+                });
+            }
+        }
+    }
+    // A box wider than a periodic grid visits some cells twice; keep each pair once.
+    sort_and_dedupe(pairs, start);
+}

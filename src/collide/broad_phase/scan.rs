@@ -1,0 +1,168 @@
+//! The single-grid pair scan: per circle in cell order, the rest of its own cell and the "half
+//! stencil" (the cell to the right and the three above), so each pair is visited once. Large
+//! scans split the rows into bands on the task pool and join the bands in row order, so the
+//! pairs and their order never depend on the number of threads.
+
+use bevy::math::DVec2;
+use bevy::tasks::{ComputeTaskPool, TaskPool};
+
+use super::cells::{CellList, PARALLEL_FROM, map_chunks};
+use crate::arena::{Arena, minimum_image};
+
+/// The single-grid broad phase, for circles of similar size: buckets `circles` (centre, reach)
+/// into `cells` (one largest diameter, `2 · max_radius`, wide), copies them into `sorted` in
+/// cell order ([`CellList::order`]) and appends the overlapping pairs as positions in that
+/// order, each pair's first member being the one with the lower input index.
+///
+/// Working in cell order keeps the scan, and whatever the caller does with the pairs, on
+/// nearby memory instead of jumping through the circles in input order.
+pub fn pairs_in_cell_order(
+    cells: &mut CellList,
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    max_radius: f64,
+    sorted: &mut Vec<(DVec2, f64)>,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    if arena.is_periodic() {
+        cells.rebuild_periodic(circles, arena.min, arena.size(), 2.0 * max_radius);
+    } else {
+        cells.rebuild(circles, 2.0 * max_radius);
+    }
+    let start = pairs.len();
+    sorted.clear();
+    sorted.resize(cells.order.len(), (DVec2::ZERO, 0.0));
+    map_chunks(sorted, |from, out| {
+        for (slot, &i) in out.iter_mut().zip(&cells.order[from..]) {
+            *slot = circles[i as usize];
+        }
+    });
+    let rows = cells.grid.rows;
+    if circles.len() >= PARALLEL_FROM {
+        let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+        let bands = (pool.thread_num() * 4).clamp(1, rows);
+        let per_band = rows.div_ceil(bands);
+        let cells = &*cells;
+        let sorted = &*sorted;
+        let found = pool.scope(|scope| {
+            for band in 0..bands {
+                let rows = band * per_band..((band + 1) * per_band).min(rows);
+                scope.spawn(async move {
+                    let mut out = Vec::new();
+                    scan_rows(cells, sorted, arena, rows, &mut out);
+                    out
+                });
+            }
+        });
+        for band in found {
+            pairs.extend(band);
+        }
+    } else {
+        scan_rows(cells, sorted, arena, 0..rows, pairs);
+    }
+    if cells.wraps_onto_itself() {
+        sort_and_dedupe(pairs, start);
+    }
+}
+
+/// [`pairs_in_cell_order`] with the pairs translated back to input indices.
+pub fn single_level_pairs(
+    cells: &mut CellList,
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    max_radius: f64,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    let start = pairs.len();
+    let mut sorted = std::mem::take(&mut cells.sorted);
+    pairs_in_cell_order(cells, arena, circles, max_radius, &mut sorted, pairs);
+    cells.sorted = sorted;
+    for pair in &mut pairs[start..] {
+        *pair = (cells.order[pair.0 as usize], cells.order[pair.1 as usize]);
+    }
+}
+
+/// Sorts `pairs[start..]` and drops repeats.
+pub fn sort_and_dedupe(pairs: &mut Vec<(u32, u32)>, start: usize) {
+    let mut found = pairs.split_off(start);
+    found.sort_unstable();
+    found.dedup();
+    pairs.append(&mut found);
+}
+
+/// Scans the cells of `rows`, appending overlapping pairs. Visiting circles rather than cells
+/// skips the empty cells, which outnumber circles in a sparse gas.
+pub(super) fn scan_rows(
+    cells: &CellList,
+    sorted: &[(DVec2, f64)],
+    arena: &Arena,
+    rows: std::ops::Range<usize>,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    if arena.is_periodic() {
+        let size = arena.size();
+        scan_rows_with(
+            cells,
+            sorted,
+            |a, b| minimum_image(b - a, size),
+            rows,
+            pairs,
+        );
+    } else {
+        scan_rows_with(cells, sorted, |a, b| b - a, rows, pairs);
+    }
+}
+
+/// [`scan_rows`] with the displacement function fixed at compile time.
+fn scan_rows_with(
+    cells: &CellList,
+    sorted: &[(DVec2, f64)],
+    offset: impl Fn(DVec2, DVec2) -> DVec2,
+    rows: std::ops::Range<usize>,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    let (cols, start) = (cells.grid.cols, &cells.start);
+    for y in rows {
+        let row = y * cols;
+        for x in 0..cols {
+            let here = start[row + x] as usize..start[row + x + 1] as usize;
+            if here.is_empty() {
+                continue;
+            }
+            let (ranges, len) = if cells.grid.periodic {
+                cells.periodic_later_neighbours(x, y)
+            } else {
+                // Open grid, written out: own and right cell, then the three cells above.
+                let right = (x + 1).min(cols - 1);
+                let mut ranges: [std::ops::Range<usize>; 5] = Default::default();
+                ranges[0] = here.start..start[row + right + 1] as usize;
+                if y + 1 < cells.grid.rows {
+                    let up = row + cols;
+                    ranges[1] =
+                        start[up + x.saturating_sub(1)] as usize..start[up + right + 1] as usize;
+                }
+                (ranges, 2)
+            };
+            for k in here.clone() {
+                let (p, r) = sorted[k];
+                for range in &ranges[..len] {
+                    // Within its own cell a circle meets only the ones after it.
+                    let from = if range.contains(&k) {
+                        k + 1
+                    } else {
+                        range.start
+                    };
+                    for (l, &(q, s)) in sorted[from..range.end].iter().enumerate() {
+                        let reach = r + s;
+                        if offset(p, q).length_squared() < reach * reach {
+                            let (k, l) = (k as u32, (from + l) as u32);
+                            // Oriented so the first has the lower input index.
+                            let lower_first = cells.order[k as usize] < cells.order[l as usize];
+                            pairs.push(if lower_first { (k, l) } else { (l, k) });
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! One contact pass of the discrete solvers, without an App: every overlapping pair found by
+//! the broad phase is resolved with [`resolve_contact`] in a fixed order (Gauss-Seidel: each
+//! pair sees the corrections of the pairs before it). Also [`separate_overlaps`], the same pass
+//! with positions only, which scene loading uses to push explicit circles apart.
+
+use bevy::math::DVec2;
+
+use super::broad_phase::{
+    CellList, needs_levels, overlapping_pairs, pairs_in_cell_order, radius_range,
+};
+use super::contact::resolve_contact;
+use crate::arena::Arena;
+use crate::boundary::reflect_off_walls;
+use crate::circle::CircleState;
+
+/// The circles of one collision pass, and buffers reused from pass to pass so the hot path
+/// does not allocate. Centres and radii sit together (what the broad phase reads); velocities
+/// and masses apart (read only for the pairs that touch).
+#[derive(Default)]
+pub struct ContactScratch {
+    discs: Vec<(DVec2, f64)>,
+    velocities: Vec<DVec2>,
+    masses: Vec<f64>,
+    /// `discs` in cell order, while contacts are resolved.
+    sorted: Vec<(DVec2, f64)>,
+    /// `0, 1, 2, …`: the order of the multi-level path, which resolves in input order.
+    identity: Vec<u32>,
+    pairs: Vec<(u32, u32)>,
+    cells: CellList,
+}
+
+impl ContactScratch {
+    /// Forgets the circles of the last pass.
+    pub fn clear(&mut self) {
+        self.discs.clear();
+        self.velocities.clear();
+        self.masses.clear();
+    }
+
+    /// Adds a circle to the next [`resolve_all_contacts`].
+    #[inline]
+    pub fn push(&mut self, position: DVec2, velocity: DVec2, radius: f64, mass: f64) {
+        self.discs.push((position, radius));
+        self.velocities.push(velocity);
+        self.masses.push(mass);
+    }
+
+    /// Centre of circle `i` now.
+    pub fn position(&self, i: usize) -> DVec2 {
+        self.discs[i].0
+    }
+
+    /// Velocity of circle `i` now.
+    pub fn velocity(&self, i: usize) -> DVec2 {
+        self.velocities[i]
+    }
+}
+
+/// What one collision pass found and did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassStats {
+    /// Pairs that were approaching and got an impulse.
+    pub collisions: u64,
+    /// Overlapping pairs found.
+    pub contacts: u64,
+    /// `Σ (r_a + r_b) · j` over collisions: the collisional virial.
+    pub virial: f64,
+}
+
+/// Finds and resolves all overlapping pairs among the circles in `scratch`, in the broad
+/// phase's scan order.
+///
+/// Circles of similar size are found in cell order ([`pairs_in_cell_order`]) and their centres
+/// are corrected in that order, on nearby memory; radii spanning decades go through the
+/// multi-level broad phase in input order.
+pub fn resolve_all_contacts(
+    scratch: &mut ContactScratch,
+    arena: &Arena,
+    restitution: f64,
+) -> PassStats {
+    let ContactScratch {
+        discs,
+        velocities,
+        masses,
+        sorted,
+        identity,
+        pairs,
+        cells,
+    } = scratch;
+    pairs.clear();
+    let radii = radius_range(discs);
+    let order: &[u32] = if needs_levels(radii) {
+        overlapping_pairs(cells, arena, discs, pairs);
+        sorted.clone_from(discs);
+        identity.clear();
+        identity.extend(0..discs.len() as u32);
+        identity
+    } else {
+        pairs_in_cell_order(cells, arena, discs, radii.1, sorted, pairs);
+        cells.order()
+    };
+    let mut stats = PassStats::default();
+    let circle = |(position, radius): (DVec2, f64), velocity, mass| CircleState {
+        position,
+        velocity,
+        radius,
+        mass,
+        tint: [0; 3],
+    };
+    for &(k, l) in pairs.iter() {
+        let (k, l) = (k as usize, l as usize);
+        let (i, j) = (order[k] as usize, order[l] as usize);
+        let mut a = circle(sorted[k], velocities[i], masses[i]);
+        // Work on the image of `b` nearest to `a`.
+        let image = a.position + arena.offset(a.position, sorted[l].0);
+        let shift = sorted[l].0 - image;
+        let mut b = circle((image, sorted[l].1), velocities[j], masses[j]);
+        let outcome = resolve_contact(&mut a, &mut b, restitution);
+        (sorted[k].0, velocities[i]) = (a.position, a.velocity);
+        (sorted[l].0, velocities[j]) = (b.position + shift, b.velocity);
+        stats.contacts += u64::from(outcome.penetration > 0.0);
+        if outcome.impulse > 0.0 {
+            stats.collisions += 1;
+            stats.virial += (a.radius + b.radius) * outcome.impulse;
+        }
+    }
+    // Only circles in a pair can have moved.
+    for &(k, l) in pairs.iter() {
+        for k in [k as usize, l as usize] {
+            discs[order[k] as usize].0 = sorted[k].0;
+        }
+    }
+    stats
+}
+
+/// Pushes overlapping circles apart (positions only, split by inverse mass, kept inside the
+/// arena), for at most a bounded number of sweeps; whatever still overlaps is for the caller's
+/// overlap check to report.
+pub fn separate_overlaps(circles: &mut [CircleState], arena: &Arena) {
+    let mut scratch = ContactScratch::default();
+    for _ in 0..1000 {
+        scratch.clear();
+        for c in circles.iter() {
+            // No velocities: no impulses, only positions move.
+            scratch.push(c.position, DVec2::ZERO, c.radius, c.mass);
+        }
+        let stats = resolve_all_contacts(&mut scratch, arena, 1.0);
+        for (i, c) in circles.iter_mut().enumerate() {
+            let mut p = scratch.position(i);
+            if arena.is_periodic() {
+                p = arena.wrap(p);
+            } else {
+                let mut at_rest = DVec2::ZERO;
+                reflect_off_walls(&mut p, &mut at_rest, c.radius, arena, 1.0);
+            }
+            c.position = p;
+        }
+        if stats.contacts == 0 {
+            break;
+        }
+    }
+}

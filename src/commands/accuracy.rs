@@ -1,0 +1,50 @@
+//! `moving_circles accuracy`: run the accuracy study with a progress bar, print its table and
+//! write `accuracy.csv` and `accuracy.svg`.
+
+use std::path::Path;
+
+use anyhow::Context;
+
+use crate::accuracy::plot::plot;
+use crate::accuracy::report::{to_csv, to_table};
+use crate::accuracy::{default_cases, settings, study};
+use crate::io::{say, write_atomically};
+
+/// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
+/// writes its CSV and plot into `out`.
+pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
+    let cases = default_cases(scenes, quick)?;
+    let settings = settings(quick);
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let bar = indicatif::ProgressBar::new((cases.len() * (settings.len() + 1)) as u64).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {msg}")
+            .expect("valid template"),
+    );
+    let mut started = false;
+    let rows = study(&cases, &settings, |case, setting| {
+        if started {
+            bar.inc(1);
+        }
+        started = true;
+        bar.set_message(match setting {
+            None => format!("{}: exact reference", case.name),
+            Some((solver, dt)) => format!("{}: {solver} at {:.0} Hz", case.name, 1.0 / dt),
+        });
+    });
+    bar.finish_and_clear();
+    say(to_table(&rows).trim_end());
+    let csv = out.join("accuracy.csv");
+    let text = to_csv(&rows).context("formatting the CSV")?;
+    write_atomically(&csv, text.as_bytes())
+        .with_context(|| format!("writing {}", csv.display()))?;
+    let svg = out.join("accuracy.svg");
+    let drawing = plot(&rows).map_err(|e| anyhow::anyhow!("drawing {}: {e}", svg.display()))?;
+    write_atomically(&svg, drawing.as_bytes())
+        .with_context(|| format!("writing {}", svg.display()))?;
+    say(format_args!(
+        "wrote {} and {}",
+        csv.display(),
+        svg.display()
+    ));
+    Ok(())
+}

@@ -1,0 +1,27 @@
+//! `moving_circles systems`: the systems a scene schedules, one `schedule system` per line.
+
+use std::path::Path;
+
+use crate::io::say;
+use crate::run::headless_app;
+use crate::scene::Scene;
+use crate::schedule::scheduled_systems;
+
+/// Prints the systems the scene at `scene` schedules, for the step schedule its solver runs.
+pub fn systems(scene: &Path) -> anyhow::Result<()> {
+    let config = Scene::load(scene)?;
+    let idle_step = if config.solver.is_continuous() {
+        "CircleStep"
+    } else {
+        "ContinuousStep"
+    };
+    let mut app = headless_app(config);
+    for (schedule, system) in scheduled_systems(&mut app) {
+        if schedule == idle_step {
+            continue;
+        }
+        let name = system.rsplit("::").next().unwrap_or(&system);
+        say(format_args!("{schedule} {name}"));
+    }
+    Ok(())
+}

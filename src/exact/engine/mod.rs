@@ -1,0 +1,379 @@
+//! The event-driven engine: circles fly in straight lines between events, and events (pair
+//! collisions, wall hits, cell crossings) are processed in time order.
+//!
+//! Each circle has exactly one pending event, its soonest, held in an indexed [`EventQueue`].
+//! A pair event remembers its partner's collision counter; if the partner has collided since,
+//! the event is stale, and since nothing can have happened to the owner before it, the owner is
+//! simply predicted again from that moment ([`predict`]).
+//!
+//! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)`. A [`Grid`] of cells
+//! at least one largest diameter wide, with memberships kept up to date by cell-crossing
+//! events, keeps prediction local. A crossing changes no trajectory, so it bumps no counter
+//! (events other circles hold with the crosser stay valid). Everything is f64.
+
+mod predict;
+
+use bevy::math::DVec2;
+
+use super::queue::EventQueue;
+use crate::arena::{Arena, minimum_image};
+use crate::boundary::reflect_off_walls;
+use crate::circle::CircleState;
+use crate::collide::contact::{apply_impulse, contact_normal};
+use crate::grid::{CellMembers, Grid, NONE};
+
+/// Counts of what the engine did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EventStats {
+    /// Circle-circle collisions processed.
+    pub pair_collisions: u64,
+    /// Wall hits processed.
+    pub wall_collisions: u64,
+    /// Momentum taken up by the walls, `Σ m |Δv|`.
+    pub wall_impulse: f64,
+    /// `Σ (r_a + r_b) · j` over collisions.
+    pub virial: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// Nothing ahead (a resting circle alone).
+    Idle,
+    Pair,
+    Wall {
+        axis: u8,
+    },
+    Cell {
+        axis: u8,
+        up: bool,
+    },
+}
+
+/// A circle's pending event (its time lives in the queue).
+#[derive(Clone, Copy, Debug)]
+struct Event {
+    kind: Kind,
+    partner: u32,
+    partner_count: u32,
+}
+
+/// What prediction reads for each circle, kept together for the cache.
+#[derive(Clone, Copy, Debug)]
+struct Motion {
+    /// Position at time `t_at`.
+    pos: DVec2,
+    vel: DVec2,
+    t_at: f64,
+    radius: f64,
+}
+
+impl Motion {
+    #[inline]
+    fn at(&self, t: f64) -> DVec2 {
+        self.pos + self.vel * (t - self.t_at)
+    }
+}
+
+/// The soonest pair collision a circle's last look at its neighbours found.
+#[derive(Clone, Copy, Debug)]
+struct BestPair {
+    time: f64,
+    partner: u32,
+    partner_count: u32,
+}
+
+const NO_PAIR: BestPair = BestPair {
+    time: f64::INFINITY,
+    partner: NONE,
+    partner_count: 0,
+};
+
+/// Why [`EventEngine::advance_to`] stopped early.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BudgetExhausted {
+    /// Events processed before giving up.
+    pub events: u64,
+}
+
+/// An event-driven simulation of circles.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::arena::Arena;
+/// use moving_circles::circle::CircleState;
+/// use moving_circles::exact::engine::EventEngine;
+///
+/// let circles = [
+///     CircleState::new(DVec2::new(-2.0, 0.0), DVec2::new(1.0, 0.0), 0.5),
+///     CircleState::new(DVec2::new(2.0, 0.0), DVec2::new(-1.0, 0.0), 0.5),
+/// ];
+/// let mut engine = EventEngine::new(&circles, &Arena::default(), 1.0, 1.0);
+/// engine.advance_to(2.0, u64::MAX).unwrap();
+/// assert_eq!(engine.stats().pair_collisions, 1); // they met at t = 1.5
+/// assert_eq!(engine.velocity(0), DVec2::new(-1.0, 0.0));
+/// ```
+#[derive(Clone, Debug)]
+pub struct EventEngine {
+    arena: Arena,
+    /// `arena.size()`, kept for the minimum image in the innermost loop.
+    period: DVec2,
+    restitution: f64,
+    wall_restitution: f64,
+    now: f64,
+    motion: Vec<Motion>,
+    inv_mass: Vec<f64>,
+    /// Collisions (pair or wall) each circle has had: a pair event is valid while its
+    /// partner's count is unchanged.
+    counter: Vec<u32>,
+    event: Vec<Event>,
+    best_pair: Vec<BestPair>,
+    queue: EventQueue,
+    grid: Grid,
+    cells: CellMembers,
+    cell_x: Vec<u32>,
+    cell_y: Vec<u32>,
+    stats: EventStats,
+}
+
+impl EventEngine {
+    /// Builds the engine at time 0 and predicts every circle's first event. Circles must have
+    /// finite state; with walls their centres must lie within `[min + r, max - r]` (a centre
+    /// just outside by rounding is treated as touching the wall).
+    pub fn new(
+        circles: &[CircleState],
+        arena: &Arena,
+        restitution: f64,
+        wall_restitution: f64,
+    ) -> Self {
+        let n = circles.len();
+        let size = arena.size();
+        let largest = circles.iter().map(|c| c.radius).fold(0.0f64, f64::max);
+        let grid = Grid::tiling(arena.min, size, 2.0 * largest, n, arena.is_periodic());
+        let mut engine = Self {
+            arena: *arena,
+            period: size,
+            restitution,
+            wall_restitution,
+            now: 0.0,
+            motion: circles
+                .iter()
+                .map(|c| Motion {
+                    pos: if arena.is_periodic() {
+                        arena.wrap(c.position)
+                    } else {
+                        c.position
+                    },
+                    vel: c.velocity,
+                    t_at: 0.0,
+                    radius: c.radius,
+                })
+                .collect(),
+            inv_mass: circles.iter().map(CircleState::inv_mass).collect(),
+            counter: vec![0; n],
+            event: vec![
+                Event {
+                    kind: Kind::Idle,
+                    partner: NONE,
+                    partner_count: 0
+                };
+                n
+            ],
+            best_pair: vec![NO_PAIR; n],
+            queue: EventQueue::new(n),
+            cells: CellMembers::new(grid.len(), n),
+            grid,
+            cell_x: vec![0; n],
+            cell_y: vec![0; n],
+            stats: EventStats::default(),
+        };
+        engine.relink_all();
+        engine.predict_all();
+        engine
+    }
+
+    /// Current simulated time.
+    pub fn now(&self) -> f64 {
+        self.now
+    }
+
+    /// Number of circles.
+    pub fn len(&self) -> usize {
+        self.motion.len()
+    }
+
+    /// Whether there are no circles.
+    pub fn is_empty(&self) -> bool {
+        self.motion.is_empty()
+    }
+
+    /// What the engine has done so far.
+    pub fn stats(&self) -> EventStats {
+        self.stats
+    }
+
+    /// Position of circle `i` now.
+    pub fn position(&self, i: usize) -> DVec2 {
+        self.motion[i].at(self.now)
+    }
+
+    /// Velocity of circle `i`.
+    pub fn velocity(&self, i: usize) -> DVec2 {
+        self.motion[i].vel
+    }
+
+    /// Processes every event up to time `t_end` and moves the clock there. Stops early (with the
+    /// clock at the last processed event) after `max_events` events.
+    pub fn advance_to(&mut self, t_end: f64, max_events: u64) -> Result<u64, BudgetExhausted> {
+        let mut processed = 0;
+        while let Some((i, time)) = self.queue.first() {
+            if time > t_end {
+                break;
+            }
+            let event = self.event[i];
+            if event.kind == Kind::Pair
+                && self.counter[event.partner as usize] != event.partner_count
+            {
+                // The partner moved on; the owner's path is unchanged up to now: predict again.
+                self.now = time.max(self.now);
+                self.predict(i);
+                continue;
+            }
+            if processed == max_events {
+                return Err(BudgetExhausted { events: processed });
+            }
+            processed += 1;
+            self.now = time.max(self.now);
+            match event.kind {
+                Kind::Pair => self.collide(i, event.partner as usize),
+                Kind::Wall { axis } => self.hit_wall(i, axis as usize),
+                Kind::Cell { axis, up } => self.cross_cell(i, axis as usize, up),
+                Kind::Idle => unreachable!("idle circles wait at +∞"),
+            }
+        }
+        self.now = t_end;
+        Ok(processed)
+    }
+
+    /// Moves every circle in a straight line to `t` without processing events (walls fold the
+    /// motion back inside, periodic edges wrap), then predicts afresh. The fallback when a step's
+    /// event budget runs out: collisions skipped here show up as overlapping, approaching pairs,
+    /// which collide at once on the next advance.
+    pub fn drift_to(&mut self, t: f64) {
+        let arena = self.arena;
+        for (m, count) in self.motion.iter_mut().zip(&mut self.counter) {
+            let mut p = m.at(t);
+            if arena.is_periodic() {
+                p = arena.wrap(p);
+            } else {
+                reflect_off_walls(&mut p, &mut m.vel, m.radius, &arena, self.wall_restitution);
+            }
+            m.pos = p;
+            m.t_at = t;
+            *count += 1;
+        }
+        self.now = t;
+        self.relink_all();
+        self.predict_all();
+    }
+
+    fn advance_circle(&mut self, i: usize, t: f64) {
+        let m = &mut self.motion[i];
+        m.pos = m.at(t);
+        m.t_at = t;
+    }
+
+    /// The displacement from `a` to `b` (minimum image on a periodic arena).
+    #[inline]
+    fn offset(&self, a: DVec2, b: DVec2) -> DVec2 {
+        if self.grid.periodic {
+            minimum_image(b - a, self.period)
+        } else {
+            b - a
+        }
+    }
+
+    fn cell_index(&self, i: usize) -> usize {
+        self.grid
+            .index(self.cell_x[i] as usize, self.cell_y[i] as usize)
+    }
+
+    /// Puts every circle in the cell its current position lies in.
+    fn relink_all(&mut self) {
+        self.cells.clear();
+        for i in 0..self.len() {
+            let (x, y) = self.grid.cell_of(self.motion[i].pos);
+            self.cell_x[i] = x as u32;
+            self.cell_y[i] = y as u32;
+            self.cells.insert(i, self.grid.index(x, y));
+        }
+    }
+
+    fn collide(&mut self, i: usize, j: usize) {
+        let now = self.now;
+        self.advance_circle(i, now);
+        self.advance_circle(j, now);
+        let (a, b) = (self.motion[i], self.motion[j]);
+        let (n, _) = contact_normal(self.offset(a.pos, b.pos), a.vel - b.vel);
+        let (mut va, mut vb) = (a.vel, b.vel);
+        let (wa, wb) = (self.inv_mass[i], self.inv_mass[j]);
+        if let Some(impulse) = apply_impulse(n, &mut va, &mut vb, wa, wb, self.restitution) {
+            self.motion[i].vel = va;
+            self.motion[j].vel = vb;
+            self.stats.pair_collisions += 1;
+            self.stats.virial += (a.radius + b.radius) * impulse;
+        }
+        self.counter[i] += 1;
+        self.counter[j] += 1;
+        self.predict(i);
+        self.predict(j);
+    }
+
+    fn hit_wall(&mut self, i: usize, axis: usize) {
+        if self.arena.is_periodic() {
+            return;
+        }
+        self.advance_circle(i, self.now);
+        let (min, max) = (self.arena.min, self.arena.max);
+        let m = &mut self.motion[i];
+        let (lo, hi) = (min[axis] + m.radius, max[axis] - m.radius);
+        let v = m.vel[axis];
+        // Snap onto the wall (the event time puts it there up to rounding) and reflect.
+        m.pos[axis] = if v > 0.0 { hi } else { lo };
+        let new_v = -self.wall_restitution * v;
+        m.vel[axis] = new_v;
+        if self.inv_mass[i] > 0.0 {
+            self.stats.wall_impulse += (new_v - v).abs() / self.inv_mass[i];
+        }
+        self.stats.wall_collisions += 1;
+        self.counter[i] += 1;
+        self.predict(i);
+    }
+
+    fn cross_cell(&mut self, i: usize, axis: usize, up: bool) {
+        self.advance_circle(i, self.now);
+        self.cells.remove(i, self.cell_index(i));
+        let (count, cell) = if axis == 0 {
+            (self.grid.cols as u32, &mut self.cell_x[i])
+        } else {
+            (self.grid.rows as u32, &mut self.cell_y[i])
+        };
+        let mut wrapped = 0.0;
+        if up {
+            *cell += 1;
+            if *cell == count {
+                *cell = 0;
+                wrapped = -1.0;
+            }
+        } else if *cell == 0 {
+            *cell = count - 1;
+            wrapped = 1.0;
+        } else {
+            *cell -= 1;
+        }
+        if wrapped != 0.0 && self.grid.periodic {
+            self.motion[i].pos[axis] += wrapped * self.period[axis];
+        }
+        self.cells.insert(i, self.cell_index(i));
+        self.predict_after_crossing(i, axis, up);
+    }
+}

@@ -1,0 +1,152 @@
+//! Prediction: a circle's soonest event among its best pair, a wall hit and a cell crossing.
+//!
+//! Whenever a trajectory changes, its owner looks at every neighbour (the 3×3 block of cells);
+//! after a cell crossing, which changes no trajectory, the crosser looks only at the three cells
+//! it newly borders and keeps its best pair from before if that partner has not changed. So
+//! whenever a pair becomes neighbours, the one that moved looks at the other.
+
+use bevy::math::DVec2;
+
+use super::{BestPair, Event, EventEngine, Kind, NO_PAIR};
+use crate::exact::toi::{pair_time_of_impact, wall_time_of_impact};
+use crate::grid::NONE;
+
+impl EventEngine {
+    /// The soonest collision of circle `i` with a circle in `cells`, as seen from now.
+    fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
+        let now = self.now;
+        let me = self.motion[i];
+        let p = me.at(now);
+        let mut best = NO_PAIR;
+        for c in cells {
+            for j in self.cells.members(c) {
+                if j == i {
+                    continue;
+                }
+                let other = &self.motion[j];
+                let dp = self.offset(p, other.at(now));
+                if let Some(t) =
+                    pair_time_of_impact(dp, other.vel - me.vel, me.radius + other.radius)
+                    && now + t < best.time
+                {
+                    best = BestPair {
+                        time: now + t,
+                        partner: j as u32,
+                        partner_count: self.counter[j],
+                    };
+                }
+            }
+        }
+        best
+    }
+
+    /// Looks at every circle in the 3×3 block of cells around circle `i` and schedules its
+    /// soonest event.
+    pub(super) fn predict(&mut self, i: usize) {
+        let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
+        let (cols, rows) = (self.grid.cols, self.grid.rows);
+        self.best_pair[i] = if (1..cols - 1).contains(&x) && (1..rows - 1).contains(&y) {
+            // Away from the edges: nine distinct cells, no wrapping.
+            let c = self.cell_index(i);
+            let block = [c - cols, c, c + cols]
+                .into_iter()
+                .flat_map(|middle| [middle - 1, middle, middle + 1]);
+            self.scan(i, block)
+        } else {
+            let (cells, len) = self.grid.block(x, y);
+            self.scan(i, cells[..len].iter().copied())
+        };
+        self.schedule(i);
+    }
+
+    /// After circle `i` crossed into a new cell along `axis`: looks only at the three cells it
+    /// now borders for the first time and keeps the sooner of what it finds there and its best
+    /// pair from before. If that partner has collided since, the pair event is found stale when
+    /// it comes up and the circle looks at all its neighbours then, before anything it could
+    /// have missed.
+    pub(super) fn predict_after_crossing(&mut self, i: usize, axis: usize, up: bool) {
+        let best = self.best_pair[i];
+        let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
+        let ahead = if up { 1 } else { -1 };
+        let cells = (-1..=1).filter_map(|side| {
+            let (dx, dy) = if axis == 0 {
+                (ahead, side)
+            } else {
+                (side, ahead)
+            };
+            self.grid.neighbour(x, y, dx, dy)
+        });
+        let found = self.scan(i, cells);
+        if found.time < best.time {
+            self.best_pair[i] = found;
+        }
+        self.schedule(i);
+    }
+
+    /// Sets circle `i`'s event to the soonest of its best pair, a wall hit and a cell crossing.
+    fn schedule(&mut self, i: usize) {
+        let m = self.motion[i];
+        let p = m.at(self.now);
+        let best = self.best_pair[i];
+        let (mut time, mut event) = (
+            best.time,
+            Event {
+                kind: if best.partner == NONE {
+                    Kind::Idle
+                } else {
+                    Kind::Pair
+                },
+                partner: best.partner,
+                partner_count: best.partner_count,
+            },
+        );
+        let mut consider = |t: f64, kind: Kind| {
+            if t < time {
+                time = t;
+                event = Event {
+                    kind,
+                    partner: NONE,
+                    partner_count: 0,
+                };
+            }
+        };
+        let walls = !self.grid.periodic;
+        let (min, max): (DVec2, DVec2) = (self.arena.min, self.arena.max);
+        for axis in 0..2u8 {
+            let a = axis as usize;
+            let v = m.vel[a];
+            if v == 0.0 {
+                continue;
+            }
+            if walls
+                && let Some((t, _)) =
+                    wall_time_of_impact(p[a], v, min[a] + m.radius, max[a] - m.radius)
+            {
+                consider(self.now + t, Kind::Wall { axis });
+            }
+            // Cell crossing along this axis (none past the outer cells of a walled box).
+            let (cell, last) = if a == 0 {
+                (self.cell_x[i] as usize, self.grid.cols - 1)
+            } else {
+                (self.cell_y[i] as usize, self.grid.rows - 1)
+            };
+            let up = v > 0.0;
+            if walls && ((up && cell == last) || (!up && cell == 0)) {
+                continue;
+            }
+            let edge = self.grid.edge(a, cell + usize::from(up));
+            consider(
+                self.now + ((edge - p[a]) / v).max(0.0),
+                Kind::Cell { axis, up },
+            );
+        }
+        self.event[i] = event;
+        self.queue.set(i, time);
+    }
+
+    pub(super) fn predict_all(&mut self) {
+        for i in 0..self.len() {
+            self.predict(i);
+        }
+    }
+}

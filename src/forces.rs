@@ -1,0 +1,63 @@
+//! The force effects: [`GravityPlugin`] (`v += g·dt`) and [`DragPlugin`] (`v *= exp(-drag·dt)`),
+//! in [`CircleSystems::Forces`] before the move, under every solver. Each schedules its system
+//! only when the scene calls for it (`effects.gravity`, `effects.drag`).
+
+use bevy::ecs::schedule::ScheduleLabel;
+use bevy::prelude::*;
+
+use crate::components::Velocity;
+use crate::config::Effects;
+use crate::effects::{Effect, EffectSystems, register_effect};
+use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepDt};
+
+/// Constant acceleration `effects.gravity`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GravityPlugin;
+
+impl Plugin for GravityPlugin {
+    fn build(&self, app: &mut App) {
+        // Forces change velocity before the move (semi-implicit Euler), so they run in both the
+        // discrete substep and the continuous step.
+        register_effect(
+            app,
+            Effect::Gravity,
+            &[CircleStep.intern(), ContinuousStep.intern()],
+            || apply_gravity.in_set(CircleSystems::Forces).into_configs(),
+        );
+    }
+}
+
+/// Linear drag at the rate `effects.drag` (1/s), after gravity.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DragPlugin;
+
+impl Plugin for DragPlugin {
+    fn build(&self, app: &mut App) {
+        register_effect(
+            app,
+            Effect::Drag,
+            &[CircleStep.intern(), ContinuousStep.intern()],
+            || {
+                apply_drag
+                    .in_set(CircleSystems::Forces)
+                    .after(EffectSystems(Effect::Gravity))
+                    .into_configs()
+            },
+        );
+    }
+}
+
+/// `v += g·dt` for every circle.
+fn apply_gravity(effects: Res<Effects>, dt: Res<StepDt>, mut circles: Query<&mut Velocity>) {
+    let Some(g) = effects.gravity else { return };
+    let dv = g * dt.0;
+    circles.par_iter_mut().for_each(|mut v| v.0 += dv);
+}
+
+/// `v *= exp(-drag·dt)`: the exact solution of `v' = -drag·v` over the step, so it can never
+/// overshoot and reverse a velocity however large `dt` is.
+fn apply_drag(effects: Res<Effects>, dt: Res<StepDt>, mut circles: Query<&mut Velocity>) {
+    let Some(drag) = effects.drag else { return };
+    let factor = (-drag * dt.0).exp();
+    circles.par_iter_mut().for_each(|mut v| v.0 *= factor);
+}

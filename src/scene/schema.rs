@@ -1,0 +1,111 @@
+//! The scene file's schema: the RON a scene is written in ([`Scene`], [`ArenaSpec`],
+//! [`CircleSpec`]), every field with a default so a file names only what it changes, and
+//! [`Scene::parse`], which reads the text and names the line and column of a syntax error or an
+//! unknown field. Checking the values is `check`'s job.
+
+use bevy::math::DVec2;
+use serde::Deserialize;
+
+use crate::arena::Boundary;
+use crate::config::{Effects, MassModel, Solver, SpawnConfig};
+use crate::error::InputError;
+
+/// The arena as a scene file gives it.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ArenaSpec {
+    /// Width and height.
+    pub size: DVec2,
+    /// Centre.
+    pub center: DVec2,
+    /// `walls` or `periodic`.
+    pub boundary: Boundary,
+}
+
+impl Default for ArenaSpec {
+    fn default() -> Self {
+        Self {
+            size: DVec2::new(16.0, 9.0),
+            center: DVec2::ZERO,
+            boundary: Boundary::Walls,
+        }
+    }
+}
+
+/// One circle placed exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CircleSpec {
+    /// Centre.
+    pub position: DVec2,
+    /// Velocity (default: at rest).
+    #[serde(default)]
+    pub velocity: DVec2,
+    /// Radius.
+    pub radius: f64,
+    /// Mass; by default from the scene's mass model.
+    #[serde(default)]
+    pub mass: Option<f64>,
+    /// Colour as sRGB bytes; by default light grey.
+    #[serde(default)]
+    pub color: Option<[u8; 3]>,
+}
+
+/// A scene file. Every field has a default, so a file names only what it changes.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Scene {
+    /// Short name.
+    pub name: String,
+    /// What the scene shows.
+    pub description: String,
+    /// Size, centre and boundary.
+    pub arena: ArenaSpec,
+    /// Effects and their parameters (the boundary is the arena's).
+    pub effects: Effects,
+    /// How masses are assigned where a circle does not give its own.
+    pub mass: MassModel,
+    /// How a step is advanced.
+    pub solver: Solver,
+    /// Fixed step in seconds.
+    pub dt: f64,
+    /// Random circles, if any.
+    pub spawn: Option<SpawnConfig>,
+    /// Circles placed exactly.
+    pub circles: Vec<CircleSpec>,
+    /// Push apart explicit circles that overlap instead of rejecting the scene.
+    pub separate_overlaps: bool,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Self {
+            name: String::new(),
+            description: String::new(),
+            arena: ArenaSpec::default(),
+            effects: Effects::default(),
+            mass: MassModel::default(),
+            solver: Solver::default(),
+            dt: 1.0 / 60.0,
+            spawn: None,
+            circles: Vec::new(),
+            separate_overlaps: false,
+        }
+    }
+}
+
+impl Scene {
+    /// Reads a scene from RON text. `origin` names the source in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Self, InputError> {
+        let options = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+        options.from_str::<Scene>(text).map_err(|e| InputError {
+            origin: origin.to_owned(),
+            location: Some(format!(
+                "line {}, column {}",
+                e.span.start.line, e.span.start.col
+            )),
+            message: e.code.to_string(),
+        })
+    }
+}
