@@ -8,9 +8,19 @@ use bevy::prelude::*;
 use common::*;
 
 fn one_circle(effects: &str, boundary: &str, position: &str, velocity: &str) -> App {
+    one_circle_under("discrete", effects, boundary, position, velocity)
+}
+
+fn one_circle_under(
+    solver: &str,
+    effects: &str,
+    boundary: &str,
+    position: &str,
+    velocity: &str,
+) -> App {
     scene_app(&format!(
-        "(arena: (size: (10.0, 10.0), boundary: {boundary}), effects: ({effects}),
-          circles: [(position: {position}, velocity: {velocity}, radius: 0.5)])"
+        "(solver: \"{solver}\", arena: (size: (10.0, 10.0), boundary: {boundary}),
+          effects: ({effects}), circles: [(position: {position}, velocity: {velocity}, radius: 0.5)])"
     ))
 }
 
@@ -19,12 +29,18 @@ fn first_state(app: &mut App) -> (DVec2, DVec2) {
     (c.0, c.1)
 }
 
+/// Checks that `system` is (or is not) scheduled, runs `steps` steps and returns the first
+/// circle's `(position, velocity)`.
+fn stepped(mut app: App, system: &str, scheduled: bool, steps: u64) -> (DVec2, DVec2) {
+    assert_scheduled(&mut app, system, scheduled);
+    step(&mut app, steps);
+    first_state(&mut app)
+}
+
 #[test]
 fn gravity_pulls_when_asked_and_is_absent_otherwise() {
-    let mut app = one_circle("gravity: (0.0, -2.0)", "walls", "(0.0, 2.0)", "(0.0, 0.0)");
-    assert_scheduled(&mut app, "apply_gravity", true);
-    step(&mut app, 60);
-    let (p, v) = first_state(&mut app);
+    let app = one_circle("gravity: (0.0, -2.0)", "walls", "(0.0, 2.0)", "(0.0, 0.0)");
+    let (p, v) = stepped(app, "apply_gravity", true, 60);
     // Semi-implicit Euler: v exact, x = x0 + g dt² n(n+1)/2 = 2 - 2·(1/60)²·1830.
     assert!((v.y + 2.0).abs() < 1e-5, "v = {v}");
     assert!(
@@ -32,18 +48,49 @@ fn gravity_pulls_when_asked_and_is_absent_otherwise() {
         "p = {p}"
     );
 
-    let mut app = one_circle("", "walls", "(0.0, 2.0)", "(0.0, 0.0)");
-    assert_scheduled(&mut app, "apply_gravity", false);
-    step(&mut app, 60);
-    assert_eq!(first_state(&mut app), (DVec2::new(0.0, 2.0), DVec2::ZERO));
+    let app = one_circle("", "walls", "(0.0, 2.0)", "(0.0, 0.0)");
+    let state = stepped(app, "apply_gravity", false, 60);
+    assert_eq!(state, (DVec2::new(0.0, 2.0), DVec2::ZERO));
+}
+
+#[test]
+fn forces_act_under_every_solver_from_the_first_step() {
+    for (solver, substeps) in [
+        ("discrete", 1.0),
+        ("substeps=4", 4.0),
+        ("swept", 1.0),
+        ("exact", 1.0),
+    ] {
+        // Gravity: semi-implicit Euler over n = 60·substeps steps of h = dt / substeps.
+        let (h, n) = (1.0 / (60.0 * substeps), 60.0 * substeps);
+        let app = one_circle_under(
+            solver,
+            "gravity: (0.0, -2.0)",
+            "walls",
+            "(0.0, 2.0)",
+            "(0.0, 0.0)",
+        );
+        let (p, v) = stepped(app, "apply_gravity", true, 60);
+        assert!((v.y + 2.0).abs() < 1e-5, "{solver}: v = {v}");
+        assert!(
+            (p.y - (2.0 - 2.0 * h * h * n * (n + 1.0) / 2.0)).abs() < 1e-4,
+            "{solver}: p = {p}"
+        );
+        let app = one_circle_under(solver, "drag: 0.5", "walls", "(-4.0, 0.0)", "(2.0, 0.0)");
+        let (_, v) = stepped(app, "apply_drag", true, 120);
+        assert_relative(
+            &format!("{solver}: speed after 2 s of drag 0.5"),
+            v.x,
+            2.0 * (-1.0f64).exp(),
+            1e-5,
+        );
+    }
 }
 
 #[test]
 fn drag_slows_exponentially_when_asked_and_is_absent_otherwise() {
-    let mut app = one_circle("drag: 0.5", "walls", "(-4.0, 0.0)", "(2.0, 0.0)");
-    assert_scheduled(&mut app, "apply_drag", true);
-    step(&mut app, 120);
-    let (_, v) = first_state(&mut app);
+    let app = one_circle("drag: 0.5", "walls", "(-4.0, 0.0)", "(2.0, 0.0)");
+    let (_, v) = stepped(app, "apply_drag", true, 120);
     assert_relative(
         "speed after 2 s of drag 0.5",
         v.x,
@@ -51,10 +98,9 @@ fn drag_slows_exponentially_when_asked_and_is_absent_otherwise() {
         1e-5,
     );
 
-    let mut app = one_circle("", "walls", "(-4.0, 0.0)", "(2.0, 0.0)");
-    assert_scheduled(&mut app, "apply_drag", false);
-    step(&mut app, 120);
-    assert_eq!(first_state(&mut app).1, DVec2::new(2.0, 0.0));
+    let app = one_circle("", "walls", "(-4.0, 0.0)", "(2.0, 0.0)");
+    let (_, v) = stepped(app, "apply_drag", false, 120);
+    assert_eq!(v, DVec2::new(2.0, 0.0));
 }
 
 #[test]
