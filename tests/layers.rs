@@ -1,0 +1,293 @@
+//! The structure rules of `src/`, checked on the source text: no two files import each other
+//! through any chain (every import points from a higher layer to a lower one), and no file is
+//! over 450 lines.
+//!
+//! An import is any `crate::…` or `super::…` path in code (comments are skipped), including
+//! each branch of a `use` tree; it points at the deepest module file the path names.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Every `.rs` file under `dir`.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            files.extend(rust_files(&path));
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            files.push(path);
+        }
+    }
+    files
+}
+
+/// The module path of a file: `src/collide/mod.rs` is `["collide"]`, `src/lib.rs` is `[]`.
+fn module_of(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).unwrap().with_extension("");
+    let mut parts: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    if matches!(parts.last().map(String::as_str), Some("mod" | "lib")) {
+        parts.pop();
+    }
+    parts
+}
+
+/// The code of a file without comments, string contents and its unit tests (the `#[cfg(test)]`
+/// module at its end), so that doc links, messages and test helpers do not count as imports.
+fn code_of(text: &str) -> String {
+    let mut code = String::new();
+    for line in text.lines().take_while(|l| l.trim() != "#[cfg(test)]") {
+        let line = match line.find("//") {
+            Some(at) => &line[..at],
+            None => line,
+        };
+        let mut in_string = false;
+        for c in line.chars() {
+            if c == '"' {
+                in_string = !in_string;
+            } else if !in_string {
+                code.push(c);
+            }
+        }
+        code.push('\n');
+    }
+    code
+}
+
+/// Expands `use` trees and finds inline paths: every `crate::…` / `super::…` path, as segments.
+fn paths_in(code: &str) -> Vec<Vec<String>> {
+    let mut paths = Vec::new();
+    let bytes: Vec<char> = code.chars().collect();
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts_word = i == 0 || !(bytes[i - 1].is_alphanumeric() || bytes[i - 1] == '_');
+        let rest: String = bytes[i..bytes.len().min(i + 7)].iter().collect();
+        if starts_word && (rest.starts_with("crate::") || rest.starts_with("super::")) {
+            let (tree, end) = read_tree(&bytes, i);
+            expand(&tree, &mut Vec::new(), &mut paths);
+            i = end;
+        } else {
+            i += 1;
+        }
+    }
+    paths
+}
+
+/// The path tree starting at `at` (`a::b::{c, d::{e}}`) as text, and where it ends.
+fn read_tree(chars: &[char], at: usize) -> (String, usize) {
+    let (mut depth, mut i, mut tree) = (0, at, String::new());
+    while i < chars.len() {
+        let c = chars[i];
+        let part_of_path = c.is_alphanumeric() || c == '_' || c == ':' || c == '*';
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => break,
+            '}' => depth -= 1,
+            _ if depth == 0 && !part_of_path => break,
+            _ => {}
+        }
+        if !c.is_whitespace() {
+            tree.push(c);
+        }
+        i += 1;
+    }
+    (tree, i)
+}
+
+/// Adds every path of a use tree (`a::{b, c::d}` is `a::b` and `a::c::d`) to `out`.
+fn expand(tree: &str, prefix: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+    let Some(open) = tree.find('{') else {
+        let mut path = prefix.clone();
+        path.extend(
+            tree.split("::")
+                .filter(|s| !s.is_empty())
+                .map(str::to_owned),
+        );
+        out.push(path);
+        return;
+    };
+    let head: Vec<String> = tree[..open]
+        .split("::")
+        .filter(|s| !s.is_empty())
+        .map(str::to_owned)
+        .collect();
+    let inner = &tree[open + 1..tree.rfind('}').unwrap_or(tree.len())];
+    let mut depth = 0;
+    let mut start = 0;
+    let mut branches = Vec::new();
+    for (k, c) in inner.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                branches.push(&inner[start..k]);
+                start = k + 1;
+            }
+            _ => {}
+        }
+    }
+    branches.push(&inner[start..]);
+    let base = prefix.len();
+    prefix.extend(head);
+    for branch in branches.into_iter().filter(|b| !b.is_empty()) {
+        expand(branch, prefix, out);
+    }
+    prefix.truncate(base);
+}
+
+/// The file-level import graph of `src/` (the library; the binary imports it from outside).
+fn import_graph(src: &Path) -> BTreeMap<PathBuf, BTreeSet<PathBuf>> {
+    let files: Vec<PathBuf> = rust_files(src)
+        .into_iter()
+        .filter(|f| f != &src.join("main.rs"))
+        .collect();
+    let modules: BTreeMap<Vec<String>, PathBuf> = files
+        .iter()
+        .map(|f| (module_of(src, f), f.clone()))
+        .collect();
+    let mut graph = BTreeMap::new();
+    for file in &files {
+        let here = module_of(src, file);
+        let mut targets = BTreeSet::new();
+        for path in paths_in(&code_of(&std::fs::read_to_string(file).unwrap())) {
+            let mut module: Vec<String> = Vec::new();
+            let mut segments = path.iter().peekable();
+            match segments.next().map(String::as_str) {
+                Some("crate") => {}
+                Some("super") => {
+                    // `super` of a/b.rs is a; of a/mod.rs, the parent of a.
+                    module = here.clone();
+                    module.pop();
+                    while segments.peek().is_some_and(|s| s.as_str() == "super") {
+                        segments.next();
+                        module.pop();
+                    }
+                }
+                _ => continue,
+            }
+            for segment in segments {
+                module.push(segment.clone());
+                if !modules.contains_key(&module) {
+                    module.pop();
+                    break;
+                }
+            }
+            let target = &modules[&module];
+            if target != file {
+                targets.insert(target.clone());
+            }
+        }
+        graph.insert(file.clone(), targets);
+    }
+    graph
+}
+
+/// A cycle of files, if the graph has one.
+fn find_cycle(graph: &BTreeMap<PathBuf, BTreeSet<PathBuf>>) -> Option<Vec<PathBuf>> {
+    fn visit(
+        node: &PathBuf,
+        graph: &BTreeMap<PathBuf, BTreeSet<PathBuf>>,
+        done: &mut BTreeSet<PathBuf>,
+        stack: &mut Vec<PathBuf>,
+    ) -> Option<Vec<PathBuf>> {
+        if let Some(at) = stack.iter().position(|n| n == node) {
+            let mut cycle = stack[at..].to_vec();
+            cycle.push(node.clone());
+            return Some(cycle);
+        }
+        if done.contains(node) {
+            return None;
+        }
+        stack.push(node.clone());
+        for next in &graph[node] {
+            if let Some(cycle) = visit(next, graph, done, stack) {
+                return Some(cycle);
+            }
+        }
+        stack.pop();
+        done.insert(node.clone());
+        None
+    }
+    let mut done = BTreeSet::new();
+    graph
+        .keys()
+        .find_map(|node| visit(node, graph, &mut done, &mut Vec::new()))
+}
+
+fn src() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
+}
+
+#[test]
+fn no_file_imports_itself_through_other_files() {
+    let graph = import_graph(&src());
+    let edges: usize = graph.values().map(BTreeSet::len).sum();
+    // The reader really reads: a tree this size has well over a hundred imports between files,
+    // among them these.
+    assert!(edges > 100, "only {edges} imports found");
+    for (from, to) in [
+        ("collide/pass.rs", "collide/contact.rs"),
+        ("exact/engine/predict.rs", "exact/engine/mod.rs"),
+        ("exact/engine/predict.rs", "exact/toi.rs"),
+        ("scene/check.rs", "scene/schema.rs"),
+        ("run.rs", "lib.rs"),
+    ] {
+        assert!(
+            graph[&src().join(from)].contains(&src().join(to)),
+            "{from} should import {to}: {:?}",
+            graph[&src().join(from)]
+        );
+    }
+    if let Some(cycle) = find_cycle(&graph) {
+        let names: Vec<String> = cycle
+            .iter()
+            .map(|f| f.strip_prefix(src()).unwrap().display().to_string())
+            .collect();
+        panic!("import cycle: {}", names.join(" → "));
+    }
+}
+
+#[test]
+fn a_cycle_is_found_where_there_is_one() {
+    let (a, b, c) = (PathBuf::from("a"), PathBuf::from("b"), PathBuf::from("c"));
+    let mut graph = BTreeMap::from([
+        (a.clone(), BTreeSet::from([b.clone()])),
+        (b.clone(), BTreeSet::from([c.clone()])),
+        (c.clone(), BTreeSet::new()),
+    ]);
+    assert_eq!(find_cycle(&graph), None);
+    graph.get_mut(&c).unwrap().insert(a.clone());
+    assert_eq!(find_cycle(&graph), Some(vec![a.clone(), b, c, a]));
+}
+
+#[test]
+fn use_trees_are_read_branch_by_branch() {
+    let paths = paths_in(&code_of(
+        "use crate::a::{b, c::{d, e}};\n// use crate::comment;\nlet x = super::f::g(\"crate::in_string\");",
+    ));
+    let joined: Vec<String> = paths.iter().map(|p| p.join("::")).collect();
+    assert_eq!(
+        joined,
+        [
+            "crate::a::b",
+            "crate::a::c::d",
+            "crate::a::c::e",
+            "super::f::g"
+        ]
+    );
+}
+
+#[test]
+fn no_source_file_is_over_450_lines() {
+    let long: Vec<String> = rust_files(&src())
+        .into_iter()
+        .filter_map(|f| {
+            let lines = std::fs::read_to_string(&f).unwrap().lines().count();
+            (lines > 450).then(|| format!("{} ({lines} lines)", f.display()))
+        })
+        .collect();
+    assert!(long.is_empty(), "split along their seams: {long:?}");
+}
