@@ -70,6 +70,18 @@ fn wrap_around(arena: Res<Arena>, mut circles: Query<&mut Position>) {
 /// A circle that overshot by several arena widths in one step (a huge speed or `dt`) is folded
 /// back exactly as if it had bounced each time, so it always ends inside. A circle wider than
 /// the arena on an axis is centred on that axis and its velocity there zeroed: it cannot move.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::arena::{Arena, Boundary};
+/// use moving_circles::boundary::reflect_off_walls;
+///
+/// let unit = Arena::unit_square(Boundary::Walls);
+/// // 0.15 past the right wall (centre at most 0.9 with radius 0.1), moving out.
+/// let (mut p, mut v) = (DVec2::new(1.05, 0.5), DVec2::new(1.0, 0.0));
+/// assert_eq!(reflect_off_walls(&mut p, &mut v, 0.1, &unit, 1.0), 1);
+/// assert!((p.x - 0.75).abs() < 1e-12 && v.x == -1.0);
+/// ```
 pub fn reflect_off_walls(
     position: &mut DVec2,
     velocity: &mut DVec2,

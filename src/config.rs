@@ -168,7 +168,17 @@ impl SpawnConfig {
     }
 }
 
-/// How one fixed step of simulated time is advanced.
+/// How one fixed step of simulated time is advanced. Written in scenes and on the command line
+/// as `discrete`, `substeps=N`, `swept` or `exact`.
+///
+/// ```
+/// use moving_circles::config::Solver;
+///
+/// let solver: Solver = "substeps=4".parse().unwrap();
+/// assert_eq!((solver, solver.substeps()), (Solver::Substeps(4), 4));
+/// assert_eq!(Solver::Exact.to_string(), "exact");
+/// assert!("substeps=0".parse::<Solver>().is_err());
+/// ```
 #[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[reflect(Resource, Debug)]
 pub enum Solver {

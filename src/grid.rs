@@ -113,9 +113,20 @@ impl Grid {
 
     /// The distinct cells of the 3×3 block around `(x, y)`, row by row: fewer at a plain
     /// grid's edge, and each once where a tiny periodic grid wraps onto itself.
+    #[inline]
     pub fn block(&self, x: usize, y: usize) -> ([usize; 9], usize) {
         let mut cells = [0usize; 9];
         let mut len = 0;
+        if !self.periodic {
+            // Spawning asks this for every placement attempt: clip, and nothing to deduplicate.
+            for cy in y.saturating_sub(1)..=(y + 1).min(self.rows - 1) {
+                for cx in x.saturating_sub(1)..=(x + 1).min(self.cols - 1) {
+                    cells[len] = cy * self.cols + cx;
+                    len += 1;
+                }
+            }
+            return (cells, len);
+        }
         for dy in -1..=1 {
             for dx in -1..=1 {
                 if let Some(c) = self.neighbour(x, y, dx, dy)
