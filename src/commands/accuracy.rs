@@ -20,12 +20,10 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {msg}")
             .expect("valid template"),
     );
-    let mut started = false;
+    let mut runs_done = 0;
     let rows = study(&cases, &settings, |case, setting| {
-        if started {
-            bar.inc(1);
-        }
-        started = true;
+        bar.set_position(runs_done);
+        runs_done += 1;
         bar.set_message(match setting {
             None => format!("{}: exact reference", case.name),
             Some((solver, dt)) => format!("{}: {solver} at {:.0} Hz", case.name, 1.0 / dt),
