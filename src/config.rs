@@ -23,6 +23,9 @@ pub const MAX_CIRCLES: usize = 20_000_000;
 pub const DT_RANGE: (f64, f64) = (1e-9, 60.0);
 /// Most substeps `substeps=N` may ask for.
 pub const MAX_SUBSTEPS: u32 = 1024;
+/// Smallest radius, as a fraction of the arena's smaller side: below it the solvers' rounding
+/// of positions is the size of the circle, and ratios of radii overflow.
+pub const MIN_RADIUS_FRACTION: f64 = 1e-9;
 /// Densest area fraction random placement is asked for (0.907 is the densest packing of equal
 /// disks; placement by rejection stalls long before it).
 pub const MAX_AREA_FRACTION: f64 = 0.9;
@@ -137,6 +140,16 @@ impl SpawnConfig {
                 format!("must be (min, max) with 0 < min <= max, got ({r0}, {r1})"),
             ));
         }
+        let smallest = min_radius(arena);
+        if r0 < smallest {
+            return Err(FieldError::new(
+                "radius",
+                format!(
+                    "must be at least {MIN_RADIUS_FRACTION:?} of the arena's smaller side \
+                     ({smallest:?}), got ({r0:?}, {r1:?})"
+                ),
+            ));
+        }
         let (s0, s1) = self.speed;
         if !(s0.is_finite() && s1.is_finite() && s0 >= 0.0 && s0 <= s1) {
             return Err(FieldError::new(
@@ -166,6 +179,12 @@ impl SpawnConfig {
         }
         Ok(())
     }
+}
+
+/// The smallest radius a circle in `arena` may have ([`MIN_RADIUS_FRACTION`] of its smaller
+/// side).
+pub fn min_radius(arena: &Arena) -> f64 {
+    MIN_RADIUS_FRACTION * arena.size().min_element()
 }
 
 /// How one fixed step of simulated time is advanced. Written in scenes and on the command line

@@ -4,6 +4,8 @@
 
 use std::fmt;
 
+use crate::io::printable;
+
 /// A configuration value that cannot be used: the field (as a path like `spawn.radius`) and
 /// what is wrong with it.
 ///
@@ -15,8 +17,7 @@ use std::fmt;
 /// assert_eq!(err.field, "effects.restitution");
 /// assert_eq!(err.to_string(), "effects.restitution: must be in [0, 1], got 1.5");
 /// ```
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{field}: {message}")]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FieldError {
     /// Where in the configuration, e.g. `spawn.radius` or `circles[2].position`.
     pub field: String,
@@ -41,6 +42,19 @@ impl FieldError {
         }
     }
 }
+
+impl fmt::Display for FieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}: {}",
+            printable(&self.field),
+            printable(&self.message)
+        )
+    }
+}
+
+impl std::error::Error for FieldError {}
 
 /// A problem with an input file, located as precisely as the input allows.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -89,9 +103,11 @@ impl InputError {
 
 impl fmt::Display for InputError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Origins are file names and messages quote the file: neither reaches a terminal raw.
+        let (origin, message) = (printable(&self.origin), printable(&self.message));
         match &self.location {
-            Some(at) => write!(f, "{}: {at}: {}", self.origin, self.message),
-            None => write!(f, "{}: {}", self.origin, self.message),
+            Some(at) => write!(f, "{origin}: {}: {message}", printable(at)),
+            None => write!(f, "{origin}: {message}"),
         }
     }
 }

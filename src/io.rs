@@ -1,5 +1,8 @@
 //! Output: [`write_atomically`] is how every output file of the project (reports, dumps, the
-//! accuracy CSV and plot, screenshots) reaches the disk, and [`say`] how the commands print.
+//! accuracy CSV and plot, screenshots) reaches the disk, [`say`] how the commands print, and
+//! [`printable`] what keeps bytes from input files and names from reaching a terminal raw.
+
+use std::borrow::Cow;
 
 use std::io::Write;
 use std::path::Path;
@@ -45,11 +48,36 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// `text` with every control character (ESC, BEL, CR, NUL, newline, …) written as a Rust escape
+/// (`\u{1b}`, `\r`, …), so that a file name or a word quoted from a file cannot move the cursor,
+/// retitle the terminal or forge a line of output. Other text, non-ASCII included, is kept.
+///
+/// ```
+/// use moving_circles::io::printable;
+///
+/// assert_eq!(printable("ok × 2"), "ok × 2");
+/// assert_eq!(printable("a\u{1b}]0;pwned\u{7}b\n"), "a\\u{1b}]0;pwned\\u{7}b\\n");
+/// ```
+pub fn printable(text: &str) -> Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    Cow::Owned(out)
+}
+
 /// Writes a line to stdout. A closed pipe (`moving_circles run … | head -1`) ends the reader's
 /// interest, not the work: the files asked for are still written, so a failed write to stdout
 /// is ignored instead of panicking as `println!` does.
 pub fn say(line: impl std::fmt::Display) {
-    let _ = writeln!(std::io::stdout().lock(), "{line}");
+    let _ = writeln!(std::io::stdout().lock(), "{}", printable(&line.to_string()));
 }
 
 #[cfg(test)]

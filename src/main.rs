@@ -10,8 +10,10 @@ use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
 use moving_circles::arena::Boundary;
 use moving_circles::commands;
+use moving_circles::commands::run::MAX_THREADS;
 use moving_circles::commands::run::{Input, Length, RunOptions, SolverChoice};
 use moving_circles::config::{DT_RANGE, Solver};
+use moving_circles::io::printable;
 
 /// Moving, colliding circles. Without a subcommand, opens the app.
 #[derive(Parser, Debug)]
@@ -113,7 +115,7 @@ struct RunArgs {
     dump: Option<PathBuf>,
     /// Threads for the parallel parts of a step (default: one per core). Results do not depend
     /// on it.
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=i64::from(MAX_THREADS)))]
     threads: Option<u16>,
 }
 
@@ -180,7 +182,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("moving_circles: {e:#}");
+            eprintln!("moving_circles: {}", printable(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }

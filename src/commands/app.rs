@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use crate::config::{CirclesConfig, Solver};
+use crate::io::printable;
 use crate::render::{self, NO_WINDOW_HINT};
 use crate::scene::{Scene, classic};
 
@@ -39,6 +40,8 @@ pub fn app_config(options: &AppOptions) -> anyhow::Result<CirclesConfig> {
     if let Some(solver) = options.solver {
         config.solver = solver;
     }
+    // The overrides go through the same check as the file did (`--count` past the limit).
+    config.check()?;
     Ok(config)
 }
 
@@ -61,7 +64,10 @@ pub fn open(options: AppOptions) -> anyhow::Result<bool> {
             .location()
             .map(|l| format!(" ({l})"))
             .unwrap_or_default();
-        eprintln!("moving_circles: the app stopped: {message}{location}\n\n{NO_WINDOW_HINT}");
+        eprintln!(
+            "moving_circles: the app stopped: {}{location}\n\n{NO_WINDOW_HINT}",
+            printable(message)
+        );
     }));
     let options = render::AppOptions {
         scene_file: options.scene,

@@ -16,6 +16,10 @@ use crate::run::{Report, default_sampling, headless_app, run_steps};
 use crate::scene::{Scene, particles};
 use crate::spawn::SpawnReport;
 
+/// Most threads `--threads` may ask for: far more than any machine this runs on has cores, and
+/// few enough that starting them cannot exhaust the process.
+pub const MAX_THREADS: u16 = 1024;
+
 /// Where the circles come from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Input {
@@ -88,6 +92,8 @@ pub fn run(options: RunOptions) -> anyhow::Result<()> {
     if let Some(seed) = options.seed {
         config.spawn.seed = seed;
     }
+    // The overrides go through the same check as the file did.
+    config.check()?;
     config.solver = choose(&config, options.solver, options.tolerance)?;
     let steps = match options.length {
         Length::Steps(0) => bail!("--steps must be at least 1"),

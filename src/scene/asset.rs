@@ -14,6 +14,7 @@ use crate::arena::Arena;
 use crate::config::{CirclesConfig, Effects, Solver, SpawnConfig};
 use crate::effects::reconcile_effects;
 use crate::error::InputError;
+use crate::io::printable;
 use crate::schedule::allow_long_steps;
 use crate::spawn::{FixedCircles, Respawn};
 
@@ -120,7 +121,8 @@ fn report_failed_reload(mut failures: MessageReader<AssetLoadFailedEvent<SceneAs
     for failure in failures.read() {
         error!(
             "scene {} was not (re)loaded, the last good scene keeps running: {}",
-            failure.path, failure.error
+            printable(&failure.path.to_string()),
+            printable(&failure.error.to_string())
         );
     }
 }

@@ -14,7 +14,7 @@ use crate::circle::{CircleState, discs};
 use crate::collide::overlaps::overlapping_circles;
 use crate::collide::pass::separate_overlaps;
 use crate::components::Tint;
-use crate::config::{CirclesConfig, SpawnConfig};
+use crate::config::{CirclesConfig, MIN_RADIUS_FRACTION, SpawnConfig, min_radius};
 use crate::error::{FieldError, InputError};
 
 impl Scene {
@@ -129,6 +129,17 @@ pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
         return Err(FieldError::new(
             "mass",
             format!("must be positive, got {}", c.mass),
+        ));
+    }
+    if c.radius < min_radius(arena) {
+        return Err(FieldError::new(
+            "radius",
+            // `{:?}` writes extreme magnitudes with an exponent instead of 300 digits.
+            format!(
+                "{:?} is below {MIN_RADIUS_FRACTION:?} of the arena's smaller side ({:?})",
+                c.radius,
+                min_radius(arena)
+            ),
         ));
     }
     let size = arena.size();

@@ -9,6 +9,10 @@ use super::cells::{CellList, radius_range};
 use super::scan::{single_level_pairs, sort_and_dedupe};
 use crate::arena::Arena;
 
+/// Most size levels: a factor of 4 each, so 4⁶⁴ ≈ 3·10³⁸ between the smallest and largest
+/// circle before the largest are lumped together (correct, just slower).
+const MAX_LEVELS: usize = 64;
+
 struct Level {
     members: Vec<u32>,
     cells: CellList,
@@ -23,7 +27,10 @@ pub fn multi_level_pairs(
     r_min: f64,
     pairs: &mut Vec<(u32, u32)>,
 ) {
-    let level_of = |r: f64| ((r / r_min).log2() / 2.0).floor().max(0.0) as usize;
+    // A ratio that overflows (a subnormal radius beside a normal one) is infinite, which `as`
+    // saturates; the cap keeps the level index in range.
+    let level_of =
+        |r: f64| (((r / r_min).log2() / 2.0).floor().max(0.0) as usize).min(MAX_LEVELS - 1);
     let mut members: Vec<Vec<u32>> = Vec::new();
     for (i, &(_, r)) in circles.iter().enumerate() {
         let l = level_of(r);

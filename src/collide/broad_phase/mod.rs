@@ -199,6 +199,19 @@ mod tests {
     }
 
     #[test]
+    fn radii_across_the_whole_f64_range_neither_panic_nor_miss_a_pair() {
+        // Subnormal beside normal: the ratio of radii overflows to infinity.
+        let radii = [5e-324, 1e-310, 1e-200, 1e-3, 0.25, 0.5];
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let positions: Vec<DVec2> = (0..300)
+            .map(|_| DVec2::new(rng.random_range(0.0..4.0), rng.random_range(0.0..4.0)))
+            .collect();
+        let radii: Vec<f64> = (0..300).map(|i| radii[i % radii.len()]).collect();
+        let expected = pairs_checked(Arena::default(), &positions, &radii);
+        assert!(!expected.is_empty());
+    }
+
+    #[test]
     fn non_finite_positions_take_part_in_no_pair() {
         let circles = [
             (DVec2::ZERO, 0.1),
