@@ -3,14 +3,13 @@
 //! [`printable`] what keeps bytes from input files and names from reaching a terminal raw.
 
 use std::borrow::Cow;
-
-use std::io::Write;
+use std::io::{self, Write};
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Writes `bytes` to `path` atomically: to a new temporary file beside it (created exclusively,
-/// so no other writer shares it), synced, then renamed over `path`. A reader never sees half a
-/// file, and a failed write leaves the old file intact and no temporary file behind.
+/// Writes `bytes` to `path` atomically: to a temporary file beside it with an unpredictable
+/// name, created exclusively (no other writer, no planted link, can share it), synced, then
+/// renamed over `path`. A reader never sees half a file; a failed write leaves the old file
+/// intact and removes the temporary one. `path` must pass [`check_output_path`].
 ///
 /// ```
 /// let path = std::env::temp_dir().join(format!("mc-doc-{}.txt", std::process::id()));
@@ -18,34 +17,98 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// assert_eq!(std::fs::read(&path).unwrap(), b"whole");
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    static WRITES: AtomicU64 = AtomicU64::new(0);
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(
-        ".{name}.{}.{}.partial",
-        std::process::id(),
-        WRITES.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = (|| {
-        let mut file = std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    check_output_path(path)?;
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let prefix = format!(".{name}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".partial");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // What a plain `File::create` would give: 0666 less the umask.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    result
+    let mut file = builder.tempfile_in(directory_of(path))?;
+    file.write_all(bytes)?;
+    file.as_file().sync_all()?;
+    // On failure the temporary file comes back inside the error and is removed as it drops.
+    file.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// Whether `path` can take an output: its folder exists, and the path is free or a regular
+/// file. Directories, devices, pipes, sockets and symbolic links are refused, so that an output
+/// never replaces a device node or writes through a link somewhere else.
+pub fn check_output_path(path: &Path) -> io::Result<()> {
+    let refuse = |what: &str| {
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{} is {what}; outputs are written to regular files only",
+                path.display()
+            ),
+        )
+    };
+    if path.file_name().is_none() {
+        return Err(refuse("not a file name"));
+    }
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if meta.file_type().is_file() => {}
+        Ok(meta) => return Err(refuse(kind_of(&meta.file_type()))),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e),
+    }
+    let dir = directory_of(path);
+    if !dir.is_dir() {
+        return Err(io::Error::new(
+            io::ErrorKind::NotFound,
+            format!("{}: no such folder", dir.display()),
+        ));
+    }
+    Ok(())
+}
+
+/// Whether two output paths name the same file (the same path written two ways, or two links
+/// to one file), so that one output would silently replace the other.
+pub fn same_output(a: &Path, b: &Path) -> bool {
+    let absolute = |p: &Path| std::path::absolute(p).ok();
+    if absolute(a).is_some() && absolute(a) == absolute(b) {
+        return true;
+    }
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+fn directory_of(path: &Path) -> &Path {
+    path.parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
+fn kind_of(file_type: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file_type.is_char_device() || file_type.is_block_device() {
+            return "a device";
+        }
+        if file_type.is_fifo() {
+            return "a pipe";
+        }
+        if file_type.is_socket() {
+            return "a socket";
+        }
+    }
+    if file_type.is_dir() {
+        "a directory"
+    } else if file_type.is_symlink() {
+        "a symbolic link"
+    } else {
+        "not a regular file"
+    }
 }
 
 /// `text` with every control character (ESC, BEL, CR, NUL, newline, …) written as a Rust escape
@@ -97,15 +160,38 @@ mod tests {
             1,
             "no temporary file left behind"
         );
-        // A directory cannot be replaced by a file: the write fails and cleans up after itself.
+        // A directory or a link is never replaced, and nothing is left behind.
         let blocked = dir.join("blocked");
-        std::fs::create_dir(blocked.join("")).unwrap();
-        assert!(write_atomically(&blocked, b"x").is_err());
-        assert_eq!(
-            std::fs::read_dir(&dir).unwrap().count(),
-            2,
-            "out.txt and blocked/"
-        );
+        std::fs::create_dir(&blocked).unwrap();
+        let err = write_atomically(&blocked, b"x").unwrap_err();
+        assert!(err.to_string().contains("is a directory"), "{err}");
+        #[cfg(unix)]
+        {
+            let link = dir.join("link");
+            std::os::unix::fs::symlink(&path, &link).unwrap();
+            let err = write_atomically(&link, b"through the link").unwrap_err();
+            assert!(err.to_string().contains("is a symbolic link"), "{err}");
+            assert_eq!(std::fs::read_to_string(&path).unwrap(), "second");
+        }
+        let err = write_atomically(&dir.join("no/such/out.txt"), b"x").unwrap_err();
+        assert!(err.to_string().contains("no such folder"), "{err}");
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .filter(|n| n.to_string_lossy().ends_with(".partial"))
+            .collect();
+        assert!(left.is_empty(), "{left:?}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_same_file_named_two_ways_is_the_same_output() {
+        let here = std::env::current_dir().unwrap();
+        assert!(same_output(Path::new("r.json"), &here.join("r.json")));
+        assert!(same_output(
+            Path::new("a/../r.json"),
+            Path::new("a/../r.json")
+        ));
+        assert!(!same_output(Path::new("r.json"), Path::new("d.txt")));
     }
 }

@@ -1,7 +1,9 @@
 //! Hostile and clumsy input, through the real binary: each class of broken promise found by
 //! black-box runs stays fixed. A run must end with a clear one-line refusal (or succeed), never
 //! a panic or an abort, and nothing from a file may reach the terminal as a raw control byte.
+#![cfg(unix)]
 
+use std::os::unix::fs::FileTypeExt;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -163,5 +165,71 @@ fn bytes_from_files_and_names_reach_the_terminal_escaped() {
     let out = moving_circles(&["systems", "--scene", scene.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     assert!(!has_raw_control(&out.stderr), "{:?}", out.stderr);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn outputs_go_to_regular_files_only_and_never_to_one_file_twice() {
+    let dir = temp_dir("outputs");
+    let run_to = |flag: &str, path: &std::path::Path| {
+        moving_circles(&[
+            "run",
+            "--scene",
+            "assets/scenes/classic.ron",
+            "--steps",
+            "2",
+            flag,
+            path.to_str().unwrap(),
+        ])
+    };
+    // A pipe stands in for a device node: replacing it is what must not happen.
+    let pipe = dir.join("pipe");
+    let made = Command::new("mkfifo").arg(&pipe).status().unwrap();
+    assert!(made.success());
+    assert_refused(&run_to("--report", &pipe), &["--report: ", "is a pipe"]);
+    assert!(
+        std::fs::symlink_metadata(&pipe)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+    // A directory, and a link that would write somewhere else.
+    assert_refused(&run_to("--dump", &dir), &["--dump: ", "is a directory"]);
+    let target = dir.join("target.txt");
+    std::fs::write(&target, "keep me").unwrap();
+    let link = dir.join("link.json");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    assert_refused(&run_to("--report", &link), &["is a symbolic link"]);
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep me");
+    // A folder that does not exist fails before the run, not after it.
+    assert_refused(
+        &run_to("--report", &dir.join("missing/r.json")),
+        &["no such folder"],
+    );
+    // The report and the dump on one file, however it is spelled.
+    let same = dir.join("out.txt");
+    let spelled_otherwise = dir.join(".").join("out.txt");
+    let out = moving_circles(&[
+        "run",
+        "--scene",
+        "assets/scenes/classic.ron",
+        "--steps",
+        "2",
+        "--report",
+        same.to_str().unwrap(),
+        "--dump",
+        spelled_otherwise.to_str().unwrap(),
+    ]);
+    assert_refused(&out, &["--report and --dump name the same file"]);
+    assert!(!same.exists(), "nothing written");
+    // A good run leaves its outputs and no temporary file.
+    let report = dir.join("r.json");
+    assert!(run_to("--report", &report).status.success());
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".partial"))
+        .collect();
+    assert!(report.exists() && left.is_empty(), "{left:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

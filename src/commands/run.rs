@@ -11,7 +11,7 @@ use crate::accuracy::auto::choose_solver;
 use crate::arena::Boundary;
 use crate::circle::snapshot;
 use crate::config::{CirclesConfig, ParseSolverError, Solver};
-use crate::io::{say, write_atomically};
+use crate::io::{check_output_path, same_output, say, write_atomically};
 use crate::run::{Report, default_sampling, headless_app, run_steps};
 use crate::scene::{Scene, particles};
 use crate::spawn::SpawnReport;
@@ -85,6 +85,7 @@ pub struct RunOptions {
 
 /// Runs `options` to the end: loads, steps, prints the summary, writes the outputs.
 pub fn run(options: RunOptions) -> anyhow::Result<()> {
+    check_outputs(&options)?;
     let (mut config, source) = load(&options.input)?;
     if let Some(dt) = options.dt {
         config.dt = dt;
@@ -144,6 +145,26 @@ pub fn run(options: RunOptions) -> anyhow::Result<()> {
         let state = snapshot(app.world_mut());
         write_atomically(path, particles::format(&state).as_bytes())
             .with_context(|| format!("writing the final state to {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// Refuses, before any work, outputs that could not be written or would clobber something:
+/// paths that are not regular files (devices, directories, links), missing folders, and the
+/// report and the dump on one file.
+fn check_outputs(options: &RunOptions) -> anyhow::Result<()> {
+    for (flag, path) in [("--report", &options.report), ("--dump", &options.dump)] {
+        if let Some(path) = path {
+            check_output_path(path).with_context(|| flag.to_owned())?;
+        }
+    }
+    if let (Some(report), Some(dump)) = (&options.report, &options.dump)
+        && same_output(report, dump)
+    {
+        bail!(
+            "--report and --dump name the same file, {}: one would replace the other",
+            report.display()
+        );
     }
     Ok(())
 }
