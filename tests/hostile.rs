@@ -16,6 +16,19 @@ fn moving_circles(args: &[&str]) -> Output {
         .expect("runs")
 }
 
+/// `run` on two steps of the classic scene, with `extra` flags.
+fn run_classic(extra: &[&str]) -> Output {
+    let mut args = vec![
+        "run",
+        "--scene",
+        "assets/scenes/classic.ron",
+        "--steps",
+        "2",
+    ];
+    args.extend_from_slice(extra);
+    moving_circles(&args)
+}
+
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mc-hostile-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -79,30 +92,14 @@ fn radii_spanning_the_whole_f64_range_are_refused_not_a_panic() {
 
 #[test]
 fn thread_counts_past_the_limit_are_an_argument_error_not_an_abort() {
-    let out = moving_circles(&[
-        "run",
-        "--scene",
-        "assets/scenes/classic.ron",
-        "--steps",
-        "2",
-        "--threads",
-        "60000",
-    ]);
+    let out = run_classic(&["--threads", "60000"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "clap's usage error:\n{stderr}");
     assert!(
         stderr.contains("--threads") && stderr.contains("1..=1024"),
         "{stderr}"
     );
-    let ok = moving_circles(&[
-        "run",
-        "--scene",
-        "assets/scenes/classic.ron",
-        "--steps",
-        "2",
-        "--threads",
-        "1024",
-    ]);
+    let ok = run_classic(&["--threads", "1024"]);
     assert!(
         ok.status.success(),
         "{}",
@@ -171,17 +168,7 @@ fn bytes_from_files_and_names_reach_the_terminal_escaped() {
 #[test]
 fn outputs_go_to_regular_files_only_and_never_to_one_file_twice() {
     let dir = temp_dir("outputs");
-    let run_to = |flag: &str, path: &std::path::Path| {
-        moving_circles(&[
-            "run",
-            "--scene",
-            "assets/scenes/classic.ron",
-            "--steps",
-            "2",
-            flag,
-            path.to_str().unwrap(),
-        ])
-    };
+    let run_to = |flag: &str, path: &std::path::Path| run_classic(&[flag, path.to_str().unwrap()]);
     // A pipe stands in for a device node: replacing it is what must not happen.
     let pipe = dir.join("pipe");
     let made = Command::new("mkfifo").arg(&pipe).status().unwrap();
@@ -209,12 +196,7 @@ fn outputs_go_to_regular_files_only_and_never_to_one_file_twice() {
     // The report and the dump on one file, however it is spelled.
     let same = dir.join("out.txt");
     let spelled_otherwise = dir.join(".").join("out.txt");
-    let out = moving_circles(&[
-        "run",
-        "--scene",
-        "assets/scenes/classic.ron",
-        "--steps",
-        "2",
+    let out = run_classic(&[
         "--report",
         same.to_str().unwrap(),
         "--dump",
