@@ -1,10 +1,89 @@
-//! Output: [`write_atomically`] is how every output file of the project (reports, dumps, the
-//! accuracy CSV and plot, screenshots) reaches the disk, [`say`] how the commands print, and
-//! [`printable`] what keeps bytes from input files and names from reaching a terminal raw.
+//! Files in and out: [`write_atomically`] is how every output file of the project (reports,
+//! dumps, checkpoints, the accuracy CSV and plot, screenshots) reaches the disk,
+//! [`read_limited`] and [`Lines`] how input files are read without trusting their size, [`say`]
+//! how the commands print, and [`printable`] what keeps bytes from input files and names from
+//! reaching a terminal raw.
 
 use std::borrow::Cow;
-use std::io::{self, Write};
+use std::io::{self, BufRead, Read, Write};
 use std::path::Path;
+
+/// Most bytes a scene file may have (a scene with more circles belongs in a particle file).
+pub const MAX_SCENE_BYTES: u64 = 64 << 20;
+/// Most bytes of one line of a line-based input (particle files, checkpoints).
+pub const MAX_LINE_BYTES: usize = 4096;
+
+/// Reads all of `reader` as UTF-8 text, refusing it past `limit` bytes: a device or an endless
+/// file costs at most `limit` bytes of memory before the error. The error says what is wrong,
+/// without the file's name (the caller adds it).
+pub fn read_limited(reader: impl Read, limit: u64) -> Result<String, String> {
+    let mut bytes = Vec::new();
+    reader
+        .take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read: {e}"))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!(
+            "larger than the {} MiB this input may have",
+            limit >> 20
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "not UTF-8 text (byte {} is not valid)",
+            e.utf8_error().valid_up_to()
+        )
+    })
+}
+
+/// Where a line could not be read and why: its number and the message.
+pub type LineError = (usize, String);
+
+/// The lines of a text input, numbered from 1 and trimmed, each at most [`MAX_LINE_BYTES`]: an
+/// endless line (a device, a binary file) is an error after that many bytes, not a growing
+/// buffer. Items are `(line number, line)` or the error's line number and message.
+pub struct Lines<R> {
+    reader: R,
+    number: usize,
+    buffer: Vec<u8>,
+}
+
+impl<R: BufRead> Lines<R> {
+    /// Lines of `reader`.
+    pub fn new(reader: R) -> Self {
+        Self {
+            reader,
+            number: 0,
+            buffer: Vec::new(),
+        }
+    }
+
+    /// The next line, `None` at the end of the input.
+    #[allow(clippy::should_implement_trait)]
+    pub fn next(&mut self) -> Option<Result<(usize, &str), LineError>> {
+        self.buffer.clear();
+        self.number += 1;
+        let limit = MAX_LINE_BYTES as u64 + 1;
+        match (&mut self.reader)
+            .take(limit)
+            .read_until(b'\n', &mut self.buffer)
+        {
+            Ok(0) => return None,
+            Ok(_) => {}
+            Err(e) => return Some(Err((self.number, format!("cannot read: {e}")))),
+        }
+        if self.buffer.len() > MAX_LINE_BYTES {
+            return Some(Err((
+                self.number,
+                format!("longer than {MAX_LINE_BYTES} bytes"),
+            )));
+        }
+        Some(match std::str::from_utf8(&self.buffer) {
+            Ok(line) => Ok((self.number, line.trim())),
+            Err(_) => Err((self.number, "not UTF-8 text".to_owned())),
+        })
+    }
+}
 
 /// Writes `bytes` to `path` atomically: to a temporary file beside it with an unpredictable
 /// name, created exclusively (no other writer, no planted link, can share it), synced, then

@@ -8,13 +8,14 @@ use std::time::Duration;
 use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoadFailedEvent, AssetLoader, LoadContext};
 use bevy::prelude::*;
+use bevy::tasks::futures_lite::AsyncReadExt;
 
 use super::schema::Scene;
 use crate::arena::Arena;
 use crate::config::{CirclesConfig, Effects, Solver, SpawnConfig};
 use crate::effects::reconcile_effects;
 use crate::error::InputError;
-use crate::io::printable;
+use crate::io::{MAX_SCENE_BYTES, printable, read_limited};
 use crate::schedule::allow_long_steps;
 use crate::spawn::{FixedCircles, Respawn};
 
@@ -41,14 +42,26 @@ impl AssetLoader for SceneLoader {
         load_context: &mut LoadContext<'_>,
     ) -> Result<SceneAsset, InputError> {
         let origin = load_context.path().to_string();
+        // Read in chunks up to the limit, as `Scene::load` does: a scene that never ends costs
+        // at most the limit.
         let mut bytes = Vec::new();
-        reader
-            .read_to_end(&mut bytes)
-            .await
-            .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
-        let text = std::str::from_utf8(&bytes)
-            .map_err(|e| InputError::whole(&origin, format!("not UTF-8 text: {e}")))?;
-        let config = Scene::parse(text, &origin)?.to_config(&origin)?;
+        let mut chunk = vec![0; 64 << 10];
+        loop {
+            let read = reader
+                .read(&mut chunk)
+                .await
+                .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
+            if read == 0 {
+                break;
+            }
+            bytes.extend_from_slice(&chunk[..read]);
+            if bytes.len() as u64 > MAX_SCENE_BYTES {
+                break;
+            }
+        }
+        let text = read_limited(bytes.as_slice(), MAX_SCENE_BYTES)
+            .map_err(|message| InputError::whole(&origin, message))?;
+        let config = Scene::parse(&text, &origin)?.to_config(&origin)?;
         Ok(SceneAsset { config })
     }
 

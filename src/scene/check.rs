@@ -4,6 +4,7 @@
 //! arena ([`check_circle`]) and none overlapping another beyond rounding ([`first_overlap`]).
 //! Every error names the file and the field.
 
+use std::ops::ControlFlow;
 use std::path::Path;
 
 use bevy::math::DVec2;
@@ -11,18 +12,22 @@ use bevy::math::DVec2;
 use super::schema::Scene;
 use crate::arena::Arena;
 use crate::circle::{CircleState, discs};
-use crate::collide::overlaps::overlapping_circles;
+use crate::collide::broad_phase::visit_overlapping_pairs;
 use crate::collide::pass::separate_overlaps;
 use crate::components::Tint;
 use crate::config::{CirclesConfig, MIN_RADIUS_FRACTION, SpawnConfig, min_radius};
 use crate::error::{FieldError, InputError};
+use crate::io::{MAX_SCENE_BYTES, read_limited};
+use crate::range::{check_mass, check_vector};
 
 impl Scene {
     /// Reads and checks a scene file into a configuration.
     pub fn load(path: &Path) -> Result<CirclesConfig, InputError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
+        let text = std::fs::File::open(path)
+            .map_err(|e| format!("cannot read: {e}"))
+            .and_then(|file| read_limited(file, MAX_SCENE_BYTES))
+            .map_err(|message| InputError::whole(&origin, message))?;
         Self::parse(&text, &origin)?.to_config(&origin)
     }
 
@@ -40,18 +45,14 @@ impl Scene {
     pub fn to_config(&self, origin: &str) -> Result<CirclesConfig, InputError> {
         let field_error = |e: FieldError| InputError::from_field(origin, e);
         let size = self.arena.size;
-        if !(size.is_finite() && size.x > 0.0 && size.y > 0.0) {
+        check_vector("arena.size", size).map_err(field_error)?;
+        if !(size.x > 0.0 && size.y > 0.0) {
             return Err(field_error(FieldError::new(
                 "arena.size",
-                format!("must be two positive finite numbers, got {size}"),
+                format!("must be two positive numbers, got {size}"),
             )));
         }
-        if !self.arena.center.is_finite() {
-            return Err(field_error(FieldError::new(
-                "arena.center",
-                format!("must be finite, got {}", self.arena.center),
-            )));
-        }
+        check_vector("arena.center", self.arena.center).map_err(field_error)?;
         let arena = Arena {
             min: self.arena.center - size / 2.0,
             max: self.arena.center + size / 2.0,
@@ -90,6 +91,7 @@ impl Scene {
             config.circles.push(circle);
         }
         if self.separate_overlaps {
+            check_separable(&config.circles, &arena).map_err(field_error)?;
             separate_overlaps(&mut config.circles, &arena);
         }
         if let Some((i, j, depth)) = first_overlap(&config.circles, &arena) {
@@ -107,30 +109,15 @@ impl Scene {
 /// Checks one explicit circle: finite, positive radius and mass, inside the arena (entirely,
 /// with walls; its centre, when periodic), not larger than it.
 pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
-    if !c.position.is_finite() {
-        return Err(FieldError::new(
-            "position",
-            format!("must be finite, got {}", c.position),
-        ));
-    }
-    if !c.velocity.is_finite() {
-        return Err(FieldError::new(
-            "velocity",
-            format!("must be finite, got {}", c.velocity),
-        ));
-    }
+    check_vector("position", c.position)?;
+    check_vector("velocity", c.velocity)?;
     if !(c.radius.is_finite() && c.radius > 0.0) {
         return Err(FieldError::new(
             "radius",
             format!("must be positive and finite, got {}", c.radius),
         ));
     }
-    if c.mass.is_nan() || c.mass <= 0.0 {
-        return Err(FieldError::new(
-            "mass",
-            format!("must be positive, got {}", c.mass),
-        ));
-    }
+    check_mass("mass", c.mass)?;
     if c.radius < min_radius(arena) {
         return Err(FieldError::new(
             "radius",
@@ -182,12 +169,49 @@ pub fn rounding_slack(p: DVec2, radius: f64) -> f64 {
     4.0 * f64::EPSILON * p.abs().max_element().max(radius)
 }
 
-/// The first pair of circles that overlaps by more than rounding: `(i, j, depth)`.
+/// Most overlapping pairs per circle that `separate_overlaps` takes on: more than a packing
+/// can hold, so only circles piled on one another exceed it. Each separation sweep lists the
+/// overlapping pairs, so the cap also bounds its memory.
+pub const MAX_OVERLAPS_PER_CIRCLE: usize = 16;
+
+/// Refuses circles piled too deep to push apart, counting overlapping pairs only up to the cap.
+fn check_separable(circles: &[CircleState], arena: &Arena) -> Result<(), FieldError> {
+    let cap = MAX_OVERLAPS_PER_CIRCLE * circles.len();
+    let mut pairs = 0;
+    let _ = visit_overlapping_pairs(arena, &discs(circles), |_, _| {
+        pairs += 1;
+        if pairs > cap {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    if pairs > cap {
+        return Err(FieldError::new(
+            "separate_overlaps",
+            format!(
+                "the circles overlap in more than {MAX_OVERLAPS_PER_CIRCLE} pairs per circle: \
+                 they are piled on one another, not jostled; spread them out"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A pair of circles that overlaps by more than rounding, `(i, j, depth)` with `i < j`, if
+/// there is one. Stops at the first it meets, so an input of N circles at one point costs
+/// O(N) memory, not a list of N² pairs.
 pub fn first_overlap(circles: &[CircleState], arena: &Arena) -> Option<(usize, usize, f64)> {
-    overlapping_circles(&discs(circles), arena)
-        .into_iter()
-        .find(|&(i, j, depth)| {
-            let (a, b) = (&circles[i], &circles[j]);
-            depth > rounding_slack(a.position, a.radius).max(rounding_slack(b.position, b.radius))
-        })
+    let discs = discs(circles);
+    let mut found = None;
+    let _ = visit_overlapping_pairs(arena, &discs, |i, j| {
+        let (a, b) = (&circles[i], &circles[j]);
+        let depth = a.radius + b.radius - arena.offset(a.position, b.position).length();
+        if depth > rounding_slack(a.position, a.radius).max(rounding_slack(b.position, b.radius)) {
+            found = Some((i, j, depth));
+            return ControlFlow::Break(());
+        }
+        ControlFlow::Continue(())
+    });
+    found
 }

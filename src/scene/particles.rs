@@ -3,6 +3,7 @@
 //! square `[0, 1]²`. Read exactly — every problem names its line — and written back exactly
 //! (shortest round-trip decimal for each number).
 
+use std::io::BufRead;
 use std::path::Path;
 
 use bevy::math::DVec2;
@@ -12,12 +13,40 @@ use crate::arena::{Arena, Boundary};
 use crate::circle::CircleState;
 use crate::config::{CirclesConfig, MAX_CIRCLES, SpawnConfig};
 use crate::error::InputError;
+use crate::io::Lines;
+
+/// Most bytes a particle file may have: a dump of the most circles an input may ask for, with
+/// every number written to full precision, fits.
+pub const MAX_PARTICLE_BYTES: u64 = 4 << 30;
 
 /// Reads a particle file's text. `origin` names it in errors. Circles must lie inside the unit
 /// square (with walls: entirely; periodic: their centres) and must not overlap beyond rounding.
 pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleState>, InputError> {
-    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim()));
-    let (header_line, header) = lines.by_ref().find(|(_, l)| !l.is_empty()).ok_or_else(|| {
+    parse_from(text.as_bytes(), origin, boundary)
+}
+
+/// [`parse`] reading line by line from `reader`, at most [`MAX_PARTICLE_BYTES`] and lines of at
+/// most [`MAX_LINE_BYTES`](crate::io::MAX_LINE_BYTES): memory grows with the circles read, never with what the header
+/// claims or with a line that never ends.
+pub fn parse_from(
+    reader: impl BufRead,
+    origin: &str,
+    boundary: Boundary,
+) -> Result<Vec<CircleState>, InputError> {
+    let mut lines = Lines::new(reader.take(MAX_PARTICLE_BYTES + 1));
+    let mut next_line = || -> Result<Option<(usize, String)>, InputError> {
+        loop {
+            match lines.next() {
+                None => return Ok(None),
+                Some(Err((number, message))) => {
+                    return Err(InputError::line(origin, number, message));
+                }
+                Some(Ok((_, ""))) => continue,
+                Some(Ok((number, line))) => return Ok(Some((number, line.to_owned()))),
+            }
+        }
+    };
+    let (header_line, header) = next_line()?.ok_or_else(|| {
         InputError::whole(
             origin,
             "empty file: expected the number of circles on the first line",
@@ -40,11 +69,8 @@ pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleS
     let arena = Arena::unit_square(boundary);
     // Capacity grows with what is actually read, not with what the header claims.
     let mut circles = Vec::with_capacity(n.min(1 << 16));
-    let mut line_of = Vec::with_capacity(n.min(1 << 16));
-    for (number, line) in lines {
-        if line.is_empty() {
-            continue;
-        }
+    let mut line_of: Vec<usize> = Vec::with_capacity(n.min(1 << 16));
+    while let Some((number, line)) = next_line()? {
         if circles.len() == n {
             return Err(InputError::line(
                 origin,
@@ -52,7 +78,7 @@ pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleS
                 format!("more circles than the {n} the first line declares"),
             ));
         }
-        let circle = parse_circle(line).map_err(|m| InputError::line(origin, number, m))?;
+        let circle = parse_circle(&line).map_err(|m| InputError::line(origin, number, m))?;
         check_circle(&circle, &arena)
             .map_err(|e| InputError::line(origin, number, format!("{} {}", e.field, e.message)))?;
         circles.push(circle);
@@ -119,9 +145,9 @@ fn parse_circle(line: &str) -> Result<CircleState, String> {
 /// Reads a particle file.
 pub fn read(path: &Path, boundary: Boundary) -> Result<Vec<CircleState>, InputError> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path)
+    let file = std::fs::File::open(path)
         .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
-    parse(&text, &origin, boundary)
+    parse_from(std::io::BufReader::new(file), &origin, boundary)
 }
 
 /// The particle-format text of `circles`.
@@ -204,7 +230,7 @@ mod tests {
             ),
             (
                 "1\n0.5 0.5 0 0 0.1 0 0 0 0\n",
-                "f.txt: line 2: mass must be positive",
+                "f.txt: line 2: mass must be between",
             ),
             (
                 "1\n0.5 0.5 0 0 0.1 1 0 256 0\n",

@@ -3,10 +3,12 @@
 //! of 4 per level), each level gets its own grid, and each circle also checks the cells of the
 //! finer levels under it.
 
+use std::ops::ControlFlow;
+
 use bevy::math::DVec2;
 
 use super::cells::{CellList, radius_range};
-use super::scan::{single_level_pairs, sort_and_dedupe};
+use super::scan::{single_level_pairs, sort_and_dedupe, visit_single_level};
 use crate::arena::Arena;
 
 /// Most size levels: a factor of 4 each, so 4⁶⁴ ≈ 3·10³⁸ between the smallest and largest
@@ -27,21 +29,9 @@ pub fn multi_level_pairs(
     r_min: f64,
     pairs: &mut Vec<(u32, u32)>,
 ) {
-    // A ratio that overflows (a subnormal radius beside a normal one) is infinite, which `as`
-    // saturates; the cap keeps the level index in range.
-    let level_of =
-        |r: f64| (((r / r_min).log2() / 2.0).floor().max(0.0) as usize).min(MAX_LEVELS - 1);
-    let mut members: Vec<Vec<u32>> = Vec::new();
-    for (i, &(_, r)) in circles.iter().enumerate() {
-        let l = level_of(r);
-        if members.len() <= l {
-            members.resize(l + 1, Vec::new());
-        }
-        members[l].push(i as u32);
-    }
-    let mut levels: Vec<Level> = Vec::with_capacity(members.len());
     let start = pairs.len();
-    for members in members {
+    let mut levels: Vec<Level> = Vec::new();
+    for members in split_levels(circles, r_min) {
         let own: Vec<(DVec2, f64)> = members.iter().map(|&i| circles[i as usize]).collect();
         let mut cells = CellList::default();
         let mut local = Vec::new();
@@ -57,7 +47,66 @@ pub fn multi_level_pairs(
             max_radius,
         });
     }
-    // Each circle against the finer levels: the cells its reach could touch.
+    let _ = visit_across_levels(&levels, arena, circles, &mut |i, j| {
+        pairs.push((i, j));
+        ControlFlow::Continue(())
+    });
+    // A box wider than a periodic grid visits some cells twice; keep each pair once.
+    sort_and_dedupe(pairs, start);
+}
+
+/// [`multi_level_pairs`] as a serial visit that can stop early and lists nothing: each
+/// overlapping pair `(i, j)`, `i < j`, goes to `visit` (a pair may come twice on a periodic
+/// grid narrower than three cells).
+pub fn visit_multi_level(
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    r_min: f64,
+    visit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+) -> ControlFlow<()> {
+    let mut levels: Vec<Level> = Vec::new();
+    for members in split_levels(circles, r_min) {
+        let own: Vec<(DVec2, f64)> = members.iter().map(|&i| circles[i as usize]).collect();
+        let mut cells = CellList::default();
+        let max_radius = radius_range(&own).1;
+        visit_single_level(&mut cells, arena, &own, max_radius, &mut |a, b| {
+            let (i, j) = (members[a as usize], members[b as usize]);
+            visit(i.min(j), i.max(j))
+        })?;
+        levels.push(Level {
+            members,
+            cells,
+            max_radius,
+        });
+    }
+    visit_across_levels(&levels, arena, circles, visit)
+}
+
+/// The indices of `circles` by size level (a factor of 4 in radius per level above `r_min`).
+fn split_levels(circles: &[(DVec2, f64)], r_min: f64) -> Vec<Vec<u32>> {
+    // A ratio that overflows (a subnormal radius beside a normal one) is infinite, which `as`
+    // saturates; the cap keeps the level index in range.
+    let level_of =
+        |r: f64| (((r / r_min).log2() / 2.0).floor().max(0.0) as usize).min(MAX_LEVELS - 1);
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    for (i, &(_, r)) in circles.iter().enumerate() {
+        let l = level_of(r);
+        if members.len() <= l {
+            members.resize(l + 1, Vec::new());
+        }
+        members[l].push(i as u32);
+    }
+    members
+}
+
+/// Each circle against the finer levels: the cells its reach could touch.
+fn visit_across_levels(
+    levels: &[Level],
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    visit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+) -> ControlFlow<()> {
+    let mut flow = ControlFlow::Continue(());
     for (m, coarse) in levels.iter().enumerate() {
         for &a in &coarse.members {
             let (p, r) = circles[a as usize];
@@ -69,13 +118,14 @@ pub fn multi_level_pairs(
                 fine.cells.for_each_in_box(p - reach, p + reach, |k| {
                     let b = fine.members[fine.cells.order()[k] as usize];
                     let (q, s) = circles[b as usize];
-                    if arena.offset(p, q).length_squared() < (r + s) * (r + s) {
-                        pairs.push((a.min(b), a.max(b)));
+                    if flow.is_continue() && arena.offset(p, q).length_squared() < (r + s) * (r + s)
+                    {
+                        flow = visit(a.min(b), a.max(b));
                     }
                 });
+                flow?;
             }
         }
     }
-    // A box wider than a periodic grid visits some cells twice; keep each pair once.
-    sort_and_dedupe(pairs, start);
+    ControlFlow::Continue(())
 }

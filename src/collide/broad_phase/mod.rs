@@ -11,6 +11,8 @@ pub mod cells;
 mod levels;
 pub mod scan;
 
+use std::ops::ControlFlow;
+
 use bevy::math::DVec2;
 
 use crate::arena::Arena;
@@ -55,6 +57,40 @@ pub fn overlapping_pairs(
     }
 }
 
+/// Hands every pair `(i, j)`, `i < j`, of `circles` (centre, reach) that overlaps in `arena` to
+/// `visit` until it returns [`ControlFlow::Break`], serially and without listing the pairs:
+/// memory stays O(N) however many pairs overlap, so a check can stop at the first bad pair of
+/// a hostile input. A pair may come twice on a periodic arena only a few cells wide.
+///
+/// ```
+/// use std::ops::ControlFlow;
+/// use bevy::math::DVec2;
+/// use moving_circles::arena::Arena;
+/// use moving_circles::collide::broad_phase::visit_overlapping_pairs;
+///
+/// // 1000 circles at one point overlap in 499 500 pairs; the visit stops after the first.
+/// let circles = vec![(DVec2::ZERO, 0.5); 1000];
+/// let mut seen = 0;
+/// let _ = visit_overlapping_pairs(&Arena::default(), &circles, |_, _| {
+///     seen += 1;
+///     ControlFlow::Break(())
+/// });
+/// assert_eq!(seen, 1);
+/// ```
+pub fn visit_overlapping_pairs(
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    mut visit: impl FnMut(usize, usize) -> ControlFlow<()>,
+) -> ControlFlow<()> {
+    let (r_min, r_max) = radius_range(circles);
+    let mut visit = |i: u32, j: u32| visit(i as usize, j as usize);
+    if needs_levels((r_min, r_max)) {
+        levels::visit_multi_level(arena, circles, r_min, &mut visit)
+    } else {
+        scan::visit_single_level(&mut CellList::default(), arena, circles, r_max, &mut visit)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -62,7 +98,8 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    /// The broad phase's pairs, sorted, checked against brute force.
+    /// The broad phase's pairs, sorted, checked against brute force, and the same pairs seen
+    /// by the visit.
     fn pairs_checked(arena: Arena, positions: &[DVec2], radii: &[f64]) -> Vec<(u32, u32)> {
         let circles: Vec<(DVec2, f64)> = positions
             .iter()
@@ -78,6 +115,15 @@ mod tests {
             "{arena:?}, n = {}",
             positions.len()
         );
+        let mut visited = Vec::new();
+        let _ = visit_overlapping_pairs(&arena, &circles, |i, j| {
+            assert!(i < j);
+            visited.push((i as u32, j as u32));
+            ControlFlow::Continue(())
+        });
+        visited.sort_unstable();
+        visited.dedup();
+        assert_eq!(visited, pairs, "visit, {arena:?}, n = {}", positions.len());
         pairs
     }
 

@@ -3,6 +3,8 @@
 //! scans split the rows into bands on the task pool and join the bands in row order, so the
 //! pairs and their order never depend on the number of threads.
 
+use std::ops::ControlFlow;
+
 use bevy::math::DVec2;
 use bevy::tasks::{ComputeTaskPool, TaskPool};
 
@@ -99,28 +101,66 @@ pub(super) fn scan_rows(
     rows: std::ops::Range<usize>,
     pairs: &mut Vec<(u32, u32)>,
 ) {
+    let _ = visit_rows(cells, sorted, arena, rows, &mut |k, l| {
+        pairs.push((k, l));
+        ControlFlow::Continue(())
+    });
+}
+
+/// Hands each overlapping pair of `rows` (positions in cell order, oriented as in
+/// [`pairs_in_cell_order`]) to `visit` until it says stop.
+pub(super) fn visit_rows(
+    cells: &CellList,
+    sorted: &[(DVec2, f64)],
+    arena: &Arena,
+    rows: std::ops::Range<usize>,
+    visit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+) -> ControlFlow<()> {
     if arena.is_periodic() {
         let size = arena.size();
-        scan_rows_with(
+        visit_rows_with(
             cells,
             sorted,
             |a, b| minimum_image(b - a, size),
             rows,
-            pairs,
-        );
+            visit,
+        )
     } else {
-        scan_rows_with(cells, sorted, |a, b| b - a, rows, pairs);
+        visit_rows_with(cells, sorted, |a, b| b - a, rows, visit)
     }
 }
 
-/// [`scan_rows`] with the displacement function fixed at compile time.
-fn scan_rows_with(
+/// The serial single-grid scan of every pair of `circles` (centre, reach) that overlaps, as
+/// input indices `(i, j)` with `i < j`, handed to `visit` until it says stop. Needs no memory
+/// beyond the cell list, however many pairs overlap (a periodic grid narrower than three cells
+/// may show a pair twice).
+pub fn visit_single_level(
+    cells: &mut CellList,
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    max_radius: f64,
+    visit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+) -> ControlFlow<()> {
+    if arena.is_periodic() {
+        cells.rebuild_periodic(circles, arena.min, arena.size(), 2.0 * max_radius);
+    } else {
+        cells.rebuild(circles, 2.0 * max_radius);
+    }
+    let sorted: Vec<(DVec2, f64)> = cells.order.iter().map(|&i| circles[i as usize]).collect();
+    let order = &cells.order;
+    visit_rows(cells, &sorted, arena, 0..cells.grid.rows, &mut |k, l| {
+        visit(order[k as usize], order[l as usize])
+    })
+}
+
+/// [`visit_rows`] with the displacement function fixed at compile time.
+fn visit_rows_with(
     cells: &CellList,
     sorted: &[(DVec2, f64)],
     offset: impl Fn(DVec2, DVec2) -> DVec2,
     rows: std::ops::Range<usize>,
-    pairs: &mut Vec<(u32, u32)>,
-) {
+    visit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+) -> ControlFlow<()> {
     let (cols, start) = (cells.grid.cols, &cells.start);
     for y in rows {
         let row = y * cols;
@@ -158,11 +198,13 @@ fn scan_rows_with(
                             let (k, l) = (k as u32, (from + l) as u32);
                             // Oriented so the first has the lower input index.
                             let lower_first = cells.order[k as usize] < cells.order[l as usize];
-                            pairs.push(if lower_first { (k, l) } else { (l, k) });
+                            let (a, b) = if lower_first { (k, l) } else { (l, k) };
+                            visit(a, b)?;
                         }
                     }
                 }
             }
         }
     }
+    ControlFlow::Continue(())
 }
