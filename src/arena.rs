@@ -10,6 +10,7 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::FieldError;
+use crate::range::MAX_MAGNITUDE;
 
 /// What happens at the edges of the arena.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -149,14 +150,16 @@ impl Arena {
     /// Whether the rectangle is usable: finite, with `min < max` on both axes.
     pub fn check(&self) -> Result<(), FieldError> {
         let size = self.size();
-        if self.min.is_finite() && self.max.is_finite() && size.x > 0.0 && size.y > 0.0 {
+        let within = |v: DVec2| v.is_finite() && v.abs().max_element() <= MAX_MAGNITUDE;
+        if within(self.min) && within(self.max) && size.x > 0.0 && size.y > 0.0 {
             Ok(())
         } else {
             Err(FieldError::new(
                 "arena",
                 format!(
-                    "expected finite corners with min < max on both axes, got min {} max {}",
-                    self.min, self.max
+                    "expected corners within ±{MAX_MAGNITUDE:e} with min < max on both axes, \
+                     got min ({:?}, {:?}) max ({:?}, {:?})",
+                    self.min.x, self.min.y, self.max.x, self.max.y
                 ),
             ))
         }

@@ -46,7 +46,9 @@ impl Plugin for PeriodicPlugin {
 }
 
 /// Wall hits since the last (re)spawn, under any solver.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+#[derive(
+    Resource, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
+)]
 pub struct WallCollisions {
     /// Wall reflections.
     pub count: u64,
@@ -88,21 +90,22 @@ pub fn reflect_off_walls(
     radius: f64,
     arena: &Arena,
     restitution: f64,
-) -> u32 {
-    let mut hits = 0;
+) -> u64 {
+    let mut hits: u64 = 0;
     for axis in 0..2 {
         let lo = arena.min[axis] + radius;
         let hi = arena.max[axis] - radius;
         let n = reflect_axis(&mut position[axis], &mut velocity[axis], lo, hi);
         if n > 0 && restitution != 1.0 {
-            velocity[axis] *= restitution.powi(n as i32);
+            // Past 2³¹ bounces any restitution below 1 has long rounded the speed to zero.
+            velocity[axis] *= restitution.powi(n.min(i32::MAX as u64) as i32);
         }
-        hits += n;
+        hits = hits.saturating_add(n);
     }
     hits
 }
 
-fn reflect_axis(p: &mut f64, v: &mut f64, lo: f64, hi: f64) -> u32 {
+fn reflect_axis(p: &mut f64, v: &mut f64, lo: f64, hi: f64) -> u64 {
     if *p >= lo && *p <= hi {
         return 0;
     }
@@ -127,7 +130,7 @@ fn reflect_axis(p: &mut f64, v: &mut f64, lo: f64, hi: f64) -> u32 {
         (-spans).ceil()
     } else {
         spans.floor()
-    } as u32;
+    } as u64;
     let (folded, flipped) = if m <= span {
         (m, false)
     } else {
@@ -160,10 +163,10 @@ fn bounce_off_walls(
             }
             position.0 = p;
             velocity.0 = v;
-            hits += u64::from(n);
+            hits = hits.saturating_add(n);
         }
     }
-    walls.count += hits;
+    walls.count = walls.count.saturating_add(hits);
     walls.impulse += impulse;
 }
 

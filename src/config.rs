@@ -14,10 +14,13 @@ use serde::{Deserialize, Serialize};
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::error::FieldError;
+pub use crate::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, check_vector};
 
 /// Most circles any input may ask for: random spawns and particle files alike. Checked before
-/// anything is allocated, so a file claiming 10¹¹ circles fails at once.
-pub const MAX_CIRCLES: usize = 20_000_000;
+/// anything is allocated, so a file claiming 10¹¹ circles fails at once; and small enough that
+/// reading a whole file of this many circles, only to refuse it for an overlap in its last
+/// line, stays under 1 GB of memory.
+pub const MAX_CIRCLES: usize = 5_000_000;
 /// Smallest and largest fixed step in seconds: below 1 ns the fixed clock (nanoseconds) cannot
 /// represent it; above a minute nothing sensible is being simulated.
 pub const DT_RANGE: (f64, f64) = (1e-9, 60.0);
@@ -26,6 +29,9 @@ pub const MAX_SUBSTEPS: u32 = 1024;
 /// Smallest radius, as a fraction of the arena's smaller side: below it the solvers' rounding
 /// of positions is the size of the circle, and ratios of radii overflow.
 pub const MIN_RADIUS_FRACTION: f64 = 1e-9;
+/// Most placement attempts per circle a spawn rule may ask for: beyond a few hundred, misses
+/// mean the arena is full, and more tries only make a full arena slower to give up on.
+pub const MAX_ATTEMPTS_PER_CIRCLE: u32 = 10_000;
 /// Densest area fraction random placement is asked for (0.907 is the densest packing of equal
 /// disks; placement by rejection stalls long before it).
 pub const MAX_AREA_FRACTION: f64 = 0.9;
@@ -61,17 +67,17 @@ impl MassModel {
     /// Whether masses from this model are positive and finite.
     pub fn check(self) -> Result<(), FieldError> {
         match self {
-            Self::Area { density } if !(density.is_finite() && density > 0.0) => {
-                Err(FieldError::new(
-                    "mass",
-                    format!("Area density must be positive and finite, got {density}"),
-                ))
+            Self::Area { density } => {
+                if density > 0.0 {
+                    check_magnitude("mass", density)
+                } else {
+                    Err(FieldError::new(
+                        "mass",
+                        format!("Area density must be positive, got {density:?}"),
+                    ))
+                }
             }
-            Self::Equal(m) if !(m.is_finite() && m > 0.0) => Err(FieldError::new(
-                "mass",
-                format!("Equal mass must be positive and finite, got {m}"),
-            )),
-            _ => Ok(()),
+            Self::Equal(m) => check_mass("mass", m),
         }
     }
 }
@@ -122,11 +128,8 @@ impl SpawnConfig {
         let (a, b) = self.radius;
         let mean_square = (a * a + a * b + b * b) / 3.0;
         let n = fraction * arena.area() / (std::f64::consts::PI * mean_square);
-        if n.is_finite() && n > 0.0 {
-            n.round() as usize
-        } else {
-            0
-        }
+        // An overflowing estimate saturates to usize::MAX, which the count check refuses.
+        if n > 0.0 { n.round() as usize } else { 0 }
     }
 
     /// Whether these rules can place circles in `arena`: ranges ordered, finite and positive
@@ -150,7 +153,17 @@ impl SpawnConfig {
                 ),
             ));
         }
+        check_magnitude("radius", r1)?;
+        for r in [r0, r1] {
+            check_mass("mass", self.mass.mass_of(r)).map_err(|e| {
+                FieldError::new(
+                    "mass",
+                    format!("gives a circle of radius {r:?} a mass that {}", e.message),
+                )
+            })?;
+        }
         let (s0, s1) = self.speed;
+        check_magnitude("speed", s1)?;
         if !(s0.is_finite() && s1.is_finite() && s0 >= 0.0 && s0 <= s1) {
             return Err(FieldError::new(
                 "speed",
@@ -174,8 +187,14 @@ impl SpawnConfig {
                 format!("asks for {n} circles; at most {MAX_CIRCLES} are supported"),
             ));
         }
-        if self.attempts_per_circle == 0 {
-            return Err(FieldError::new("attempts_per_circle", "must be at least 1"));
+        if !(1..=MAX_ATTEMPTS_PER_CIRCLE).contains(&self.attempts_per_circle) {
+            return Err(FieldError::new(
+                "attempts_per_circle",
+                format!(
+                    "must be from 1 to {MAX_ATTEMPTS_PER_CIRCLE}, got {}",
+                    self.attempts_per_circle
+                ),
+            ));
         }
         Ok(())
     }
@@ -327,20 +346,15 @@ impl Effects {
                 format!("must be in [0, 1], got {}", self.wall_restitution),
             ));
         }
-        if let Some(g) = self.gravity
-            && !g.is_finite()
-        {
-            return Err(FieldError::new(
-                "effects.gravity",
-                format!("must be finite, got {g}"),
-            ));
+        if let Some(g) = self.gravity {
+            check_vector("effects.gravity", g)?;
         }
         if let Some(drag) = self.drag
-            && !(drag.is_finite() && drag >= 0.0)
+            && !(0.0..=MAX_MAGNITUDE).contains(&drag)
         {
             return Err(FieldError::new(
                 "effects.drag",
-                format!("must be a finite rate >= 0 (1/s), got {drag}"),
+                format!("must be a rate from 0 to {MAX_MAGNITUDE:e} (1/s), got {drag}"),
             ));
         }
         Ok(())

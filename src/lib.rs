@@ -4,6 +4,7 @@
 pub mod accuracy;
 pub mod arena;
 pub mod boundary;
+pub mod checkpoint;
 pub mod circle;
 pub mod collide;
 pub mod commands;
@@ -17,6 +18,7 @@ pub mod forces;
 pub mod grid;
 pub mod integrate;
 pub mod io;
+pub mod range;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod run;

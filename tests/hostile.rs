@@ -7,6 +7,8 @@ use std::os::unix::fs::FileTypeExt;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
+use moving_circles::config::MAX_CIRCLES;
+
 fn moving_circles(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_moving_circles"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -110,12 +112,13 @@ fn thread_counts_past_the_limit_are_an_argument_error_not_an_abort() {
 #[test]
 fn circle_counts_past_the_limit_are_refused_before_anything_is_allocated() {
     // The app checks its overrides before it looks for a display.
-    for count in ["18446744073709551615", "20000001"] {
+    let just_over = (MAX_CIRCLES + 1).to_string();
+    for count in ["18446744073709551615", just_over.as_str()] {
         let out = moving_circles(&["--count", count]);
         assert_refused(
             &out,
             &[&format!(
-                "spawn.count: asks for {count} circles; at most 20000000"
+                "spawn.count: asks for {count} circles; at most {MAX_CIRCLES}"
             )],
         );
     }
@@ -213,5 +216,187 @@ fn outputs_go_to_regular_files_only_and_never_to_one_file_twice() {
         .filter(|n| n.ends_with(".partial"))
         .collect();
     assert!(report.exists() && left.is_empty(), "{left:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `moving_circles` under a 1 GiB address-space limit: what "no more than 1 GB before refusing"
+/// means, enforced by the kernel instead of measured.
+fn under_one_gib(args: &[&str]) -> Output {
+    let binary = env!("CARGO_BIN_EXE_moving_circles");
+    Command::new("sh")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("-c")
+        .arg(r#"ulimit -v 1048576 && exec "$0" "$@""#)
+        .arg(binary)
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+#[test]
+fn inputs_that_never_end_or_pile_up_are_refused_within_bounded_memory() {
+    let dir = temp_dir("bounded");
+    // 20 000 circles at one point: 2·10⁸ overlapping pairs if an overlap check lists them.
+    let piled = dir.join("piled.txt");
+    let mut text = String::from("20000\n");
+    for _ in 0..20_000 {
+        text.push_str("0.5 0.5 0 0 0.001 1 0 0 0\n");
+    }
+    std::fs::write(&piled, &text).unwrap();
+    let piled = piled.to_str().unwrap();
+    let out = under_one_gib(&["run", "--particles", piled, "--steps", "1"]);
+    assert_refused(&out, &["line 3: circle overlaps the one on line 2"]);
+    // The same pile as a scene asking for the circles to be pushed apart.
+    let scene = dir.join("piled.ron");
+    let circles = "(position: (0.0, 0.0), radius: 0.01),".repeat(20_000);
+    std::fs::write(
+        &scene,
+        format!("(separate_overlaps: true, circles: [{circles}])"),
+    )
+    .unwrap();
+    let out = under_one_gib(&["run", "--scene", scene.to_str().unwrap(), "--steps", "1"]);
+    assert_refused(&out, &["field `separate_overlaps`", "piled on one another"]);
+    // Endless devices: one endless line, endless text.
+    for (flag, expected) in [
+        ("--particles", "/dev/zero: line 1: longer than 4096 bytes"),
+        ("--scene", "/dev/zero: larger than the 64 MiB"),
+    ] {
+        let out = under_one_gib(&["run", flag, "/dev/zero", "--steps", "1"]);
+        assert_refused(&out, &[expected]);
+    }
+    let out = under_one_gib(&["run", "--particles", "/dev/urandom", "--steps", "1"]);
+    assert_refused(&out, &["/dev/urandom: line 1:"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn work_that_would_take_hours_is_refused_up_front() {
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["--dt", "1e-9", "--seconds", "1000"],
+            "--seconds must be positive and at most 10000000000 steps",
+        ),
+        (&["--steps", "10000000001"], "--steps must be from 1 to"),
+        (&["--steps", "0"], "--steps must be from 1 to"),
+    ];
+    for (flags, expected) in cases {
+        let mut args = vec!["run", "--scene", "assets/scenes/classic.ron"];
+        args.extend_from_slice(flags);
+        assert_refused(&moving_circles(&args), &[expected]);
+    }
+    let dir = temp_dir("hours");
+    let scene = dir.join("tries.ron");
+    std::fs::write(
+        &scene,
+        "(spawn: (count: 2, attempts_per_circle: 4294967295))",
+    )
+    .unwrap();
+    let out = moving_circles(&["run", "--scene", scene.to_str().unwrap(), "--steps", "1"]);
+    assert_refused(
+        &out,
+        &["field `spawn.attempts_per_circle`: must be from 1 to 10000"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn one_physical_range_for_every_value_of_every_input() {
+    let dir = temp_dir("range");
+    // Scenes: each value past the range names its field.
+    let scenes = [
+        (
+            "(arena: (size: (1e200, 1e200)))",
+            "field `arena.size`: must be finite and at most 1e30",
+        ),
+        ("(arena: (center: (1e308, 0.0)))", "field `arena.center`"),
+        ("(mass: Area(density: 1e308))", "field `mass`"),
+        (
+            "(mass: Equal(1e-308))",
+            "field `mass`: must be between 1e-30 and 1e30",
+        ),
+        (
+            "(effects: (gravity: (0.0, -1e200)))",
+            "field `effects.gravity`",
+        ),
+        ("(spawn: (speed: (1e155, 1e155)))", "field `spawn.speed`"),
+        ("(effects: (drag: 1e300))", "field `effects.drag`"),
+        (
+            "(circles: [(position: (0.0, 0.0), radius: 0.1, mass: inf)])",
+            "field `circles[0].mass`: must be between",
+        ),
+        (
+            "(circles: [(position: (0.0, 0.0), velocity: (1e155, 0.0), radius: 0.1)])",
+            "field `circles[0].velocity`",
+        ),
+    ];
+    for (k, (text, expected)) in scenes.iter().enumerate() {
+        let path = dir.join(format!("s{k}.ron"));
+        std::fs::write(&path, text).unwrap();
+        let out = moving_circles(&["run", "--scene", path.to_str().unwrap(), "--steps", "1"]);
+        assert_refused(&out, &[expected]);
+    }
+    // Particle files: the same rule, the same words.
+    for (line, expected) in [
+        (
+            "0.5 0.5 0 0 0.1 1e308 0 0 0",
+            "line 2: mass must be between 1e-30 and 1e30",
+        ),
+        (
+            "0.5 0.5 0 0 0.1 5e-324 0 0 0",
+            "line 2: mass must be between",
+        ),
+        (
+            "0.5 0.5 1e155 0 0.1 1 0 0 0",
+            "line 2: velocity must be finite and at most 1e30",
+        ),
+    ] {
+        let path = dir.join("p.txt");
+        std::fs::write(&path, format!("1\n{line}\n")).unwrap();
+        let out = moving_circles(&["run", "--particles", path.to_str().unwrap(), "--steps", "1"]);
+        assert_refused(&out, &[expected]);
+    }
+    // At the edges of the range a run is accepted and everything it writes is finite.
+    let path = dir.join("edge.ron");
+    std::fs::write(
+        &path,
+        "(arena: (size: (1e-3, 1e-3)), mass: Equal(1e30), \
+          effects: (gravity: (0.0, -1e30), restitution: 0.5, wall_restitution: 0.5), \
+          spawn: (count: 20, radius: (1e-5, 2e-5), speed: (1e30, 1e30)))",
+    )
+    .unwrap();
+    let (report, dump) = (dir.join("r.json"), dir.join("d.txt"));
+    let out = moving_circles(&[
+        "run",
+        "--scene",
+        path.to_str().unwrap(),
+        "--steps",
+        "50",
+        "--report",
+        report.to_str().unwrap(),
+        "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    // JSON has no NaN or infinity: a non-finite number would have been written as null. Only
+    // the pressures may be null, meaning undefined (here: every circle has come to rest).
+    for (field, value) in report.as_object().unwrap() {
+        assert!(
+            !value.is_null() || ["z", "z_wall"].contains(&field.as_str()),
+            "{field} is null: {report}"
+        );
+    }
+    let wall_hits = report["wall_collisions"].as_u64().unwrap();
+    assert!(
+        wall_hits > u64::from(u32::MAX),
+        "{wall_hits} wall hits counted past 2³²"
+    );
+    let dump = std::fs::read_to_string(&dump).unwrap();
+    assert!(!dump.contains("inf") && !dump.contains("NaN"), "{dump}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
