@@ -16,7 +16,7 @@ use crate::components::{Mass, Position, Radius, Tint, Velocity};
 /// let heavy = CircleState::new(DVec2::ZERO, DVec2::X, 0.5).with_mass(f64::INFINITY);
 /// assert_eq!(heavy.inv_mass(), 0.0); // immovable: collision kernels need no special case
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CircleState {
     /// Centre.
     pub position: DVec2,

@@ -92,7 +92,7 @@ pub fn relative_change(before: f64, now: f64) -> f64 {
 }
 
 /// Totals over a set of circles, summed in f64.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Totals {
     /// Number of circles.
     pub count: usize,

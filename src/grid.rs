@@ -149,7 +149,7 @@ impl Grid {
 
 /// Which circles are in which cell, as one linked list per cell: a circle joins or leaves a
 /// cell in O(1), and a cell's members are listed newest first.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CellMembers {
     head: Vec<u32>,
     next: Vec<u32>,
@@ -194,6 +194,40 @@ impl CellMembers {
         }
         if n != NONE {
             self.prev[n as usize] = p;
+        }
+    }
+
+    /// Whether these lists hold each of `circles` circles exactly once, in `cells` cells, circle
+    /// `i` in cell `cell_of(i)`, with every link consistent: what lists read from outside (a
+    /// checkpoint) must show before anything walks them. Says what is wrong.
+    pub fn check(
+        &self,
+        cells: usize,
+        circles: usize,
+        cell_of: impl Fn(usize) -> usize,
+    ) -> Result<(), String> {
+        if self.head.len() != cells || self.next.len() != circles || self.prev.len() != circles {
+            return Err(format!(
+                "cell lists for {} cells and {} circles, expected {cells} and {circles}",
+                self.head.len(),
+                self.next.len()
+            ));
+        }
+        let mut seen = vec![false; circles];
+        for (cell, &head) in self.head.iter().enumerate() {
+            let (mut at, mut before) = (head, NONE);
+            while at != NONE {
+                let i = at as usize;
+                if i >= circles || seen[i] || self.prev[i] != before || cell_of(i) != cell {
+                    return Err(format!("cell {cell}'s list is broken at circle {at}"));
+                }
+                seen[i] = true;
+                (before, at) = (at, self.next[i]);
+            }
+        }
+        match seen.iter().position(|&s| !s) {
+            Some(i) => Err(format!("circle {i} is in no cell list")),
+            None => Ok(()),
         }
     }
 

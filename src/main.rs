@@ -28,7 +28,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Run a scene or particle file headless and report (no window).
-    Run(RunArgs),
+    Run(Box<RunArgs>),
     /// Run the accuracy study: every solver and step on a set of scenes, measured against
     /// `exact`; prints a table and writes accuracy.csv and accuracy.svg.
     Accuracy {
@@ -75,7 +75,7 @@ struct AppArgs {
 }
 
 #[derive(Args, Debug)]
-#[command(group(clap::ArgGroup::new("input").required(true).args(["scene", "particles"])))]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["scene", "particles", "resume"])))]
 #[command(group(clap::ArgGroup::new("length").required(true).args(["seconds", "steps"])))]
 struct RunArgs {
     /// Scene file (RON).
@@ -117,6 +117,17 @@ struct RunArgs {
     /// on it.
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=i64::from(MAX_THREADS)))]
     threads: Option<u16>,
+    /// Write a checkpoint (the whole state, to go on from with `--resume`) here: at the end,
+    /// when interrupted, and every `--every` steps.
+    #[arg(long, value_name = "PATH")]
+    checkpoint: Option<PathBuf>,
+    /// Steps between checkpoints, counted from the start of the run.
+    #[arg(long, value_name = "N", requires = "checkpoint")]
+    every: Option<u64>,
+    /// Go on from a checkpoint, with its settings, for `--steps` / `--seconds` more; the result
+    /// is bit for bit that of the run without the pause.
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["solver", "dt", "seed", "boundary", "tolerance"])]
+    resume: Option<PathBuf>,
 }
 
 /// A step in seconds, as a number or a fraction (`1/60`), within [`DT_RANGE`].
@@ -148,7 +159,10 @@ impl TryFrom<RunArgs> for RunOptions {
             ),
             (Some(scene), _) => Input::Scene(scene),
             (None, Some(file)) => Input::Particles(file, args.boundary),
-            (None, None) => unreachable!("clap requires --scene or --particles"),
+            (None, None) => match args.resume {
+                Some(checkpoint) => Input::Resume(checkpoint),
+                None => unreachable!("clap requires --scene, --particles or --resume"),
+            },
         };
         let length = match (args.steps, args.seconds) {
             (Some(steps), _) => Length::Steps(steps),
@@ -165,6 +179,8 @@ impl TryFrom<RunArgs> for RunOptions {
             report: args.report,
             dump: args.dump,
             threads: args.threads,
+            checkpoint: args.checkpoint,
+            every: args.every,
         })
     }
 }
@@ -172,15 +188,17 @@ impl TryFrom<RunArgs> for RunOptions {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Run(args)) => RunOptions::try_from(args).and_then(commands::run::run),
-        Some(Command::Systems { scene }) => commands::systems::systems(&scene),
+        Some(Command::Run(args)) => RunOptions::try_from(*args)
+            .and_then(commands::run::run)
+            .map(|finished| finished.exit_code()),
+        Some(Command::Systems { scene }) => commands::systems::systems(&scene).map(|()| 0),
         Some(Command::Accuracy { out, scenes, quick }) => {
-            commands::accuracy::accuracy(&out, &scenes, quick)
+            commands::accuracy::accuracy(&out, &scenes, quick).map(|()| 0)
         }
-        None => open_app(cli.app),
+        None => open_app(cli.app).map(|()| 0),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => ExitCode::from(code),
         Err(e) => {
             eprintln!("moving_circles: {}", printable(&format!("{e:#}")));
             ExitCode::FAILURE

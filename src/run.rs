@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::CirclesPlugins;
 use crate::arena::Arena;
@@ -86,28 +86,100 @@ pub fn run_steps(
     sample_every: u64,
     mut observe: impl FnMut(Sample),
 ) -> Report {
-    let before = totals(app.world_mut());
-    let mut overlaps = Overlaps::default();
-    let mut stepping = Duration::ZERO;
-    for step in 1..=steps {
-        let start = Instant::now();
-        app.update();
-        stepping += start.elapsed();
-        if step % sample_every.max(1) == 0 || step == steps {
-            let world = app.world_mut();
-            let circles = snapshot(world);
-            let arena = *world.resource::<Arena>();
-            overlaps.add(Overlaps::measure(&discs(&circles), &arena));
-            observe(Sample {
-                step,
-                circles: &circles,
-                world,
-            });
+    let mut progress = Progress::start(app.world_mut());
+    let until = app.world().resource::<StepTotals>().steps + steps;
+    advance(
+        app,
+        &mut progress,
+        until,
+        sample_every,
+        || false,
+        &mut observe,
+    );
+    sample_end(app, &mut progress, sample_every, observe);
+    Report::new(app.world_mut(), source, &progress)
+}
+
+/// What a run has gathered besides the world's own counters: what its report is made of, and
+/// what a checkpoint keeps so that a resumed run reports the whole run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Progress {
+    /// Energy, momentum and counts when the run began.
+    pub before: Totals,
+    /// Overlaps seen in the samples so far.
+    pub overlaps: Overlaps,
+    /// Wall-clock time spent stepping so far.
+    pub stepping: Duration,
+}
+
+impl Progress {
+    /// A run beginning from the world's state now.
+    pub fn start(world: &mut World) -> Self {
+        Self {
+            before: totals(world),
+            ..Self::default()
         }
     }
-    let world = app.world_mut();
-    let after = totals(world);
-    Report::new(world, source, before, after, overlaps, stepping)
+}
+
+/// Steps `app` until its [`StepTotals`] reach `until`, or until `stop` says so after a step,
+/// timing the steps alone into `progress`. After every step whose number is a multiple of
+/// `sample_every` it measures the overlaps of a snapshot into `progress` and hands the snapshot
+/// to `observe`. Step numbers count from the start of the run, so a run resumed from a
+/// checkpoint samples exactly the steps the whole run would have. Returns whether `stop` ended
+/// it early.
+pub fn advance(
+    app: &mut App,
+    progress: &mut Progress,
+    until: u64,
+    sample_every: u64,
+    stop: impl Fn() -> bool,
+    mut observe: impl FnMut(Sample),
+) -> bool {
+    loop {
+        let step = app.world().resource::<StepTotals>().steps;
+        if step >= until {
+            return false;
+        }
+        if stop() {
+            return true;
+        }
+        let start = Instant::now();
+        app.update();
+        progress.stepping += start.elapsed();
+        if (step + 1).is_multiple_of(sample_every.max(1)) {
+            take_sample(app.world_mut(), progress, &mut observe);
+        }
+    }
+}
+
+/// Samples the final state of a run that [`advance`] did not sample (its last step not a
+/// multiple of `sample_every`), so the report covers the state it ends in. A checkpoint keeps
+/// the progress from before this, as the whole run would not have sampled here.
+pub fn sample_end(
+    app: &mut App,
+    progress: &mut Progress,
+    sample_every: u64,
+    mut observe: impl FnMut(Sample),
+) {
+    let step = app.world().resource::<StepTotals>().steps;
+    if !step.is_multiple_of(sample_every.max(1)) {
+        take_sample(app.world_mut(), progress, &mut observe);
+    }
+}
+
+fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl FnMut(Sample)) {
+    let step = world.resource::<StepTotals>().steps;
+    let circles = snapshot(world);
+    let arena = *world.resource::<Arena>();
+    progress
+        .overlaps
+        .add(Overlaps::measure(&discs(&circles), &arena));
+    observe(Sample {
+        step,
+        circles: &circles,
+        world,
+    });
 }
 
 /// Mechanical energy, momentum and counts of the world's circles under its arena and gravity.
@@ -173,17 +245,40 @@ pub struct Report {
     pub z_wall: Option<f64>,
     /// Steps of `swept` / `exact` whose event budget ran out (rest of the step free flight).
     pub budget_exhausted: u64,
+    /// Whether a signal (SIGINT, SIGTERM) ended the run before its length: the report is of
+    /// the steps done.
+    pub interrupted: bool,
 }
 
 impl Report {
-    fn new(
-        world: &World,
-        source: &str,
-        before: Totals,
-        after: Totals,
-        overlaps: Overlaps,
-        stepping: Duration,
-    ) -> Self {
+    /// Whether every circle stayed finite and every measure is a finite number (inputs within
+    /// the one physical range keep them so; this is the check that they did).
+    pub fn is_finite(&self) -> bool {
+        let numbers = [
+            self.sim_seconds,
+            self.energy_initial,
+            self.energy_final,
+            self.energy_drift,
+            self.momentum_initial[0],
+            self.momentum_initial[1],
+            self.momentum_final[0],
+            self.momentum_final[1],
+            self.max_penetration,
+            self.mean_penetration,
+            self.z.unwrap_or(0.0),
+            self.z_wall.unwrap_or(0.0),
+        ];
+        self.non_finite == 0 && numbers.iter().all(|x| x.is_finite())
+    }
+
+    /// The report of the run `progress` belongs to, as `world` stands now.
+    pub fn new(world: &mut World, source: &str, progress: &Progress) -> Self {
+        let after = totals(world);
+        let Progress {
+            before,
+            overlaps,
+            stepping,
+        } = *progress;
         let elapsed = *world.resource::<StepTotals>();
         let pairs = *world.resource::<PairCollisions>();
         let walls = *world.resource::<WallCollisions>();
@@ -232,6 +327,7 @@ impl Report {
             z: pressure.z_virial,
             z_wall: pressure.z_wall,
             budget_exhausted: world.resource::<EngineState>().budget_exhausted,
+            interrupted: false,
         }
     }
 }

@@ -54,7 +54,9 @@ pub struct ContinuousStep;
 pub struct StepDt(pub f64);
 
 /// Fixed steps advanced and the simulated time they covered, since the last (re)spawn.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+#[derive(
+    Resource, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
+)]
 pub struct StepTotals {
     /// Fixed steps advanced.
     pub steps: u64,

@@ -38,7 +38,9 @@ impl Plugin for CollidePlugin {
 }
 
 /// Circle-circle collisions since the last (re)spawn, under any solver.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+#[derive(
+    Resource, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
+)]
 pub struct PairCollisions {
     /// Impulses applied.
     pub count: u64,

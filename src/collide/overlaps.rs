@@ -33,7 +33,7 @@ pub fn overlapping_circles(circles: &[(DVec2, f64)], arena: &Arena) -> Vec<(usiz
 }
 
 /// Overlaps in one or more states, each as a fraction of the pair's smaller radius.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Overlaps {
     /// Overlapping pairs.
     pub pairs: usize,

@@ -24,7 +24,7 @@ use crate::collide::PairCollisions;
 use crate::components::{Mass, Position, Radius, Velocity};
 use crate::config::{Effects, Solver};
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
-use engine::{EventEngine, EventStats};
+use engine::{EngineSnapshot, EventEngine, EventStats};
 
 /// Events a `swept` step may process per circle before the rest of the step is free flight.
 pub const SWEPT_EVENTS_PER_CIRCLE: u64 = 64;
@@ -62,6 +62,48 @@ pub struct EngineState {
     pub budget_exhausted: u64,
     /// Times the engine was rebuilt from the ECS state.
     pub rebuilds: u64,
+}
+
+impl EngineState {
+    /// The `exact` engine kept for the next step, as data for a checkpoint (`None` under the
+    /// other solvers, which keep nothing between steps).
+    pub fn snapshot(&self) -> Option<EngineSnapshot> {
+        match self.setup {
+            Some((_, _, Solver::Exact)) => self.engine.as_ref().map(EventEngine::snapshot),
+            _ => None,
+        }
+    }
+
+    /// Puts back the `exact` engine of a checkpoint for `circles` (entities in the order of the
+    /// continuous step's query, states as the engine last wrote them), so that the next step
+    /// goes on with it instead of rebuilding.
+    pub fn restore(
+        &mut self,
+        snapshot: EngineSnapshot,
+        circles: &[(Entity, CircleState)],
+        setup: (Arena, Effects),
+    ) -> Result<(), String> {
+        let (arena, effects) = setup;
+        let states: Vec<CircleState> = circles.iter().map(|&(_, c)| c).collect();
+        let engine = EventEngine::restore(
+            snapshot,
+            &states,
+            &arena,
+            effects.restitution,
+            effects.wall_restitution,
+        )?;
+        if let Some(i) = (0..engine.len()).find(|&i| engine.position(i) != states[i].position) {
+            return Err(format!(
+                "engine state of circle {i} puts it elsewhere than the circle"
+            ));
+        }
+        self.last_stats = engine.stats();
+        self.engine = Some(engine);
+        self.entities = circles.iter().map(|&(e, _)| e).collect();
+        self.written = states.iter().map(|c| (c.position, c.velocity)).collect();
+        self.setup = Some((arena, effects, Solver::Exact));
+        Ok(())
+    }
 }
 
 /// The circles as the continuous step reads and writes them, in one query type so that every

@@ -60,6 +60,28 @@ impl EventQueue {
         (top.circle != u32::MAX).then_some((top.circle as usize, top.time))
     }
 
+    /// Every circle's time, in circle order.
+    pub fn times(&self) -> Vec<f64> {
+        let n = self.node[self.leaves..]
+            .iter()
+            .take_while(|e| e.circle != u32::MAX)
+            .count();
+        self.node[self.leaves..self.leaves + n]
+            .iter()
+            .map(|e| e.time)
+            .collect()
+    }
+
+    /// A queue holding `times` (one per circle). Each inner node is a function of the leaves
+    /// under it alone, so this is the very queue whose [`times`](Self::times) these were.
+    pub fn with_times(times: &[f64]) -> Self {
+        let mut queue = Self::new(times.len());
+        for (i, &time) in times.iter().enumerate() {
+            queue.set(i, time);
+        }
+        queue
+    }
+
     /// Sets circle `i`'s time and replays the matches on its path to the root, stopping where
     /// a node's winner does not change.
     pub fn set(&mut self, i: usize, time: f64) {
@@ -101,6 +123,19 @@ mod tests {
                 .unwrap();
             assert_eq!(q.first(), Some((want, times[want])));
         }
+    }
+
+    #[test]
+    fn a_queue_rebuilt_from_its_times_is_the_same_queue() {
+        let mut q = EventQueue::new(5);
+        for (i, t) in [(3, 1.0), (1, 1.0), (4, 0.5), (0, 7.0), (4, 2.0)] {
+            q.set(i, t);
+        }
+        let times = q.times();
+        assert_eq!(times.len(), 5);
+        let again = EventQueue::with_times(&times);
+        assert_eq!(again.node, q.node);
+        assert_eq!(again.first(), Some((1, 1.0)));
     }
 
     #[test]

@@ -12,6 +12,9 @@
 //! (events other circles hold with the crosser stay valid). Everything is f64.
 
 mod predict;
+mod snapshot;
+
+pub use snapshot::EngineSnapshot;
 
 use bevy::math::DVec2;
 
@@ -23,7 +26,7 @@ use crate::collide::contact::{apply_impulse, contact_normal};
 use crate::grid::{CellMembers, Grid, NONE};
 
 /// Counts of what the engine did.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EventStats {
     /// Circle-circle collisions processed.
     pub pair_collisions: u64,
@@ -35,7 +38,7 @@ pub struct EventStats {
     pub virial: f64,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 enum Kind {
     /// Nothing ahead (a resting circle alone).
     Idle,
@@ -50,7 +53,7 @@ enum Kind {
 }
 
 /// A circle's pending event (its time lives in the queue).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 struct Event {
     kind: Kind,
     partner: u32,
@@ -58,7 +61,7 @@ struct Event {
 }
 
 /// What prediction reads for each circle, kept together for the cache.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 struct Motion {
     /// Position at time `t_at`.
     pos: DVec2,
@@ -75,7 +78,7 @@ impl Motion {
 }
 
 /// The soonest pair collision a circle's last look at its neighbours found.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 struct BestPair {
     time: f64,
     partner: u32,
@@ -99,6 +102,7 @@ pub struct BudgetExhausted {
 ///
 /// ```
 /// use bevy::math::DVec2;
+use serde::{Deserialize, Serialize};
 /// use moving_circles::arena::Arena;
 /// use moving_circles::circle::CircleState;
 /// use moving_circles::exact::engine::EventEngine;

@@ -1,0 +1,224 @@
+//! Checkpoints: the whole state of a headless run between two steps — the settings, every
+//! circle, the counters and clocks, what the report has gathered, and the `exact` engine with
+//! its pending events — so that `run --resume` goes on bit for bit as the run would have.
+//! Written by `run --checkpoint` through [`write_atomically`](crate::io::write_atomically) in
+//! a compact binary form (postcard); read back with a size limit and every value checked, so a
+//! damaged or forged file is an error naming the file, never a panic.
+
+use std::io::Read;
+use std::path::Path;
+
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::arena::Arena;
+use crate::boundary::WallCollisions;
+use crate::circle::{CircleState, snapshot};
+use crate::collide::PairCollisions;
+use crate::components::{Mass, Position, Radius, Tint, Velocity};
+use crate::config::{CirclesConfig, Effects, MAX_CIRCLES, Solver, SpawnConfig};
+use crate::error::InputError;
+use crate::exact::EngineState;
+use crate::exact::engine::EngineSnapshot;
+use crate::range::{check_mass, check_vector};
+use crate::run::{Progress, headless_app};
+use crate::schedule::StepTotals;
+use crate::spawn::SpawnReport;
+
+/// The first field of every checkpoint: what it is and the layout's version.
+const FORMAT: &str = "moving_circles checkpoint 1";
+/// Most bytes a checkpoint may have: the most circles an input may ask for, each with its
+/// engine state, fit.
+pub const MAX_CHECKPOINT_BYTES: u64 = 2 << 30;
+
+/// A run's whole state between two steps.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Checkpoint {
+    format: String,
+    /// The scene or particle file the run began from.
+    pub source: String,
+    arena: Arena,
+    solver: Solver,
+    effects: Effects,
+    dt: f64,
+    requested: usize,
+    circles: Vec<CircleState>,
+    steps: StepTotals,
+    pairs: PairCollisions,
+    walls: WallCollisions,
+    budget_exhausted: u64,
+    progress: Progress,
+    engine: Option<EngineSnapshot>,
+}
+
+impl Checkpoint {
+    /// The state of the headless run in `world`, begun from `source`, with `progress`.
+    pub fn take(world: &mut World, source: &str, progress: &Progress) -> Self {
+        let engine = world.resource::<EngineState>();
+        let (engine, budget_exhausted) = (engine.snapshot(), engine.budget_exhausted);
+        Self {
+            format: FORMAT.to_owned(),
+            source: source.to_owned(),
+            arena: *world.resource::<Arena>(),
+            solver: *world.resource::<Solver>(),
+            effects: *world.resource::<Effects>(),
+            dt: world.resource::<Time<Fixed>>().timestep().as_secs_f64(),
+            requested: world.resource::<SpawnReport>().requested,
+            circles: snapshot(world),
+            steps: *world.resource::<StepTotals>(),
+            pairs: *world.resource::<PairCollisions>(),
+            walls: *world.resource::<WallCollisions>(),
+            budget_exhausted,
+            progress: *progress,
+            engine,
+        }
+    }
+
+    /// The checkpoint as bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        postcard::to_stdvec(self).expect("a checkpoint is plain data")
+    }
+
+    /// Reads and checks a checkpoint file.
+    pub fn read(path: &Path) -> Result<Self, InputError> {
+        let origin = path.display().to_string();
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_CHECKPOINT_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
+        if bytes.len() as u64 > MAX_CHECKPOINT_BYTES {
+            return Err(InputError::whole(
+                &origin,
+                format!(
+                    "larger than the {} GiB a checkpoint may have",
+                    MAX_CHECKPOINT_BYTES >> 30
+                ),
+            ));
+        }
+        Self::from_bytes(&bytes, &origin)
+    }
+
+    /// Reads and checks checkpoint bytes; `origin` names them in errors.
+    pub fn from_bytes(bytes: &[u8], origin: &str) -> Result<Self, InputError> {
+        let not_one = || InputError::whole(origin, "not a moving_circles checkpoint");
+        // The format string comes first: check it before decoding anything else.
+        let (format, _) = postcard::take_from_bytes::<String>(bytes).map_err(|_| not_one())?;
+        if format != FORMAT {
+            return Err(if format.starts_with("moving_circles checkpoint") {
+                InputError::whole(
+                    origin,
+                    format!(
+                        "written by another version ({}), this one reads `{FORMAT}`",
+                        crate::io::printable(&format)
+                    ),
+                )
+            } else {
+                not_one()
+            });
+        }
+        let checkpoint: Self = postcard::from_bytes(bytes)
+            .map_err(|e| InputError::whole(origin, format!("damaged checkpoint: {e}")))?;
+        checkpoint
+            .check()
+            .map_err(|message| InputError::whole(origin, message))?;
+        Ok(checkpoint)
+    }
+
+    /// Whether the settings and every value are usable (the settings through the same checks
+    /// as a scene's; circles within the physical range). Says what is wrong.
+    fn check(&self) -> Result<(), String> {
+        let describe = |e: crate::error::FieldError| format!("field `{}`: {}", e.field, e.message);
+        self.config().check().map_err(describe)?;
+        if self.circles.len() > MAX_CIRCLES {
+            return Err(format!(
+                "holds {} circles; at most {MAX_CIRCLES} are supported",
+                self.circles.len()
+            ));
+        }
+        for (i, c) in self.circles.iter().enumerate() {
+            check_vector("position", c.position)
+                .and_then(|()| check_vector("velocity", c.velocity))
+                .and_then(|()| check_mass("mass", c.mass))
+                .map_err(|e| e.within(&format!("circles[{i}]")))
+                .map_err(describe)?;
+            if !(c.radius > 0.0 && 2.0 * c.radius <= self.arena.size().min_element()) {
+                return Err(format!("circle {i} has an impossible radius {}", c.radius));
+            }
+        }
+        let p = &self.progress;
+        let numbers = [
+            self.steps.sim_seconds,
+            self.pairs.virial,
+            self.walls.impulse,
+            p.before.kinetic_energy,
+            p.before.potential_energy,
+            p.before.momentum.x,
+            p.before.momentum.y,
+            p.overlaps.max,
+            p.overlaps.sum,
+        ];
+        if numbers.iter().any(|x| !x.is_finite()) {
+            return Err("a counter or total is not finite".to_owned());
+        }
+        if self.engine.is_some() != (self.solver == Solver::Exact && !self.circles.is_empty()) {
+            return Err("the engine state does not match the solver".to_owned());
+        }
+        Ok(())
+    }
+
+    /// The settings, with the circles as explicit circles and nothing random.
+    fn config(&self) -> CirclesConfig {
+        CirclesConfig {
+            arena: self.arena,
+            spawn: SpawnConfig {
+                count: 0,
+                ..SpawnConfig::default()
+            },
+            solver: self.solver,
+            effects: self.effects,
+            dt: self.dt,
+            circles: self.circles.clone(),
+        }
+    }
+
+    /// A headless app in the checkpoint's state, and the run's progress, ready for the next
+    /// step. `origin` names the checkpoint in errors.
+    pub fn resume(self, origin: &str) -> Result<(App, Progress), InputError> {
+        let mut app = headless_app(self.config());
+        let world = app.world_mut();
+        world.insert_resource(self.steps);
+        world.insert_resource(self.pairs);
+        world.insert_resource(self.walls);
+        world.resource_mut::<SpawnReport>().requested = self.requested;
+        let circles: Vec<(Entity, CircleState)> = world
+            .query::<(Entity, &Position, &Velocity, &Radius, &Mass, &Tint)>()
+            .iter(world)
+            .map(|(e, p, v, r, m, t)| {
+                (
+                    e,
+                    CircleState {
+                        position: p.0,
+                        velocity: v.0,
+                        radius: r.0,
+                        mass: m.0,
+                        tint: t.0,
+                    },
+                )
+            })
+            .collect();
+        if circles.iter().map(|(_, c)| c).ne(self.circles.iter()) {
+            return Err(InputError::whole(
+                origin,
+                "its circles did not come back as they were written",
+            ));
+        }
+        let mut state = world.resource_mut::<EngineState>();
+        state.budget_exhausted = self.budget_exhausted;
+        if let Some(engine) = self.engine {
+            state
+                .restore(engine, &circles, (self.arena, self.effects))
+                .map_err(|message| InputError::whole(origin, message))?;
+        }
+        Ok((app, self.progress))
+    }
+}

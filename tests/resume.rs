@@ -1,0 +1,258 @@
+//! Checkpoint, resume and interruption through the real binary: a run paused at a checkpoint
+//! and resumed ends bit for bit where the run without the pause ends, under every solver; a
+//! signal ends a run after a whole step with its report, final state and checkpoint written,
+//! and a second signal ends it at once without touching what was there.
+#![cfg(unix)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn command(args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_moving_circles"));
+    command
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .stdin(Stdio::null());
+    command
+}
+
+fn run(args: &[&str]) -> Output {
+    let out = command(args).output().expect("runs");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mc-resume-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn text(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// The report without the fields that time the run.
+fn untimed(report: &Path) -> serde_json::Value {
+    let mut value: serde_json::Value = serde_json::from_str(&text(report)).unwrap();
+    let fields = value.as_object_mut().unwrap();
+    fields.remove("wall_seconds");
+    fields.remove("ms_per_step");
+    value
+}
+
+#[test]
+fn a_resumed_run_ends_bit_for_bit_where_the_whole_run_ends_under_every_solver() {
+    let dir = temp_dir("identical");
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let (whole_txt, whole_json, c1) = (p("whole.txt"), p("whole.json"), p("c1"));
+    // A walled rack of billiards and a periodic gas: the engine's events cross the pause.
+    for scene in ["assets/scenes/billiards.ron", "assets/scenes/gas1k.ron"] {
+        for solver in ["discrete", "substeps=4", "swept", "exact"] {
+            let base = ["run", "--scene", scene, "--solver", solver];
+            let whole = [&base[..], &["--steps", "240", "--dump", &whole_txt]].concat();
+            run(&[&whole[..], &["--report", &whole_json]].concat());
+            // Paused twice: checkpoints every 50 steps, the last at step 100 (the end).
+            let first = [&base[..], &["--steps", "100", "--checkpoint", &c1]].concat();
+            run(&[&first[..], &["--every", "50"]].concat());
+            run(&[
+                "run",
+                "--resume",
+                &p("c1"),
+                "--steps",
+                "73",
+                "--checkpoint",
+                &p("c2"),
+            ]);
+            run(&[
+                "run",
+                "--resume",
+                &p("c2"),
+                "--steps",
+                "67",
+                "--dump",
+                &p("resumed.txt"),
+                "--report",
+                &p("resumed.json"),
+            ]);
+            let what = format!("{scene} under {solver}");
+            assert!(
+                text(&dir.join("whole.txt")) == text(&dir.join("resumed.txt")),
+                "final states differ: {what}"
+            );
+            assert_eq!(
+                untimed(&dir.join("whole.json")),
+                untimed(&dir.join("resumed.json")),
+                "{what}"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_checkpoint_that_is_damaged_or_not_one_is_refused_by_name() {
+    let dir = temp_dir("damaged");
+    let checkpoint = dir.join("c");
+    let c = checkpoint.to_str().unwrap();
+    run(&[
+        "run",
+        "--scene",
+        "assets/scenes/billiards.ron",
+        "--solver",
+        "exact",
+        "--steps",
+        "30",
+        "--checkpoint",
+        c,
+    ]);
+    let good = std::fs::read(&checkpoint).unwrap();
+    let mut truncated = good.clone();
+    truncated.truncate(good.len() / 2);
+    let mut flipped = good.clone();
+    let last = flipped.len() - 9;
+    flipped[last] ^= 0x40;
+    let cases: [(&[u8], &str); 4] = [
+        (b"", "not a moving_circles checkpoint"),
+        (b"hello, world", "not a moving_circles checkpoint"),
+        (&truncated, "damaged checkpoint"),
+        (&flipped, ""),
+    ];
+    for (bytes, expected) in cases {
+        std::fs::write(&checkpoint, bytes).unwrap();
+        let out = command(&["run", "--resume", c, "--steps", "5"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        if out.status.success() {
+            // A flipped bit deep in a number may still be a usable state; then it must run.
+            assert!(expected.is_empty(), "accepted: {stderr}");
+        } else {
+            assert_eq!(out.status.code(), Some(1), "{stderr}");
+            assert!(stderr.contains(c) && stderr.contains(expected), "{stderr}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Starts a long run of the 10 000-circle gas writing everything, and waits until it has
+/// written its first checkpoint (so it is stepping).
+fn start_long_run(dir: &Path) -> Child {
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let checkpoint = dir.join("c");
+    let child = command(&[
+        "run",
+        "--scene",
+        "assets/scenes/gas.ron",
+        "--solver",
+        "exact",
+        "--steps",
+        "10000000",
+        "--report",
+        &p("r.json"),
+        "--dump",
+        &p("d.txt"),
+        "--checkpoint",
+        &p("c"),
+        "--every",
+        "3",
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .unwrap();
+    let start = Instant::now();
+    while !checkpoint.exists() {
+        assert!(start.elapsed() < Duration::from_secs(120), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child
+}
+
+fn signal(child: &Child, name: &str) {
+    let status = Command::new("kill")
+        .args([&format!("-{name}"), &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+#[test]
+fn a_signal_ends_the_run_after_a_step_with_everything_written() {
+    for (name, code) in [("INT", 130), ("TERM", 143)] {
+        let dir = temp_dir(&format!("signal-{name}"));
+        let mut child = start_long_run(&dir);
+        signal(&child, name);
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "SIG{name}");
+        let report: serde_json::Value = serde_json::from_str(&text(&dir.join("r.json"))).unwrap();
+        assert_eq!(report["interrupted"], true);
+        let steps = report["steps"].as_u64().unwrap();
+        assert!(steps >= 3, "{steps} steps");
+        // The dump is the state after the last whole step, and the checkpoint goes on from it.
+        let dump = text(&dir.join("d.txt"));
+        assert_eq!(dump.lines().count(), 10_029);
+        let c = dir.join("c");
+        let again = dir.join("again.json");
+        run(&[
+            "run",
+            "--resume",
+            c.to_str().unwrap(),
+            "--steps",
+            "1",
+            "--report",
+            again.to_str().unwrap(),
+        ]);
+        let again: serde_json::Value = serde_json::from_str(&text(&again)).unwrap();
+        assert_eq!(again["steps"].as_u64(), Some(steps + 1));
+        assert_eq!(again["interrupted"], false);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
+    let dir = temp_dir("twice");
+    let report = dir.join("r.json");
+    std::fs::write(&report, "old").unwrap();
+    // Placing a million circles takes seconds: both signals arrive before the first step.
+    let scene = dir.join("million.ron");
+    std::fs::write(
+        &scene,
+        "(arena: (size: (1000.0, 1000.0)), spawn: (count: 1000000, radius: (0.1, 0.1)))",
+    )
+    .unwrap();
+    let mut child = command(&[
+        "run",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--steps",
+        "100",
+        "--report",
+        report.to_str().unwrap(),
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .unwrap();
+    std::thread::sleep(Duration::from_millis(1000));
+    signal(&child, "INT");
+    std::thread::sleep(Duration::from_millis(100));
+    signal(&child, "INT");
+    let start = Instant::now();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130));
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "did not end at once"
+    );
+    assert_eq!(text(&report), "old");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "a stray file");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
