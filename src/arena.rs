@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::FieldError;
-use crate::range::MAX_MAGNITUDE;
+use crate::range::{MAX_MAGNITUDE, in_range};
 
 /// What happens at the edges of the arena.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -150,8 +150,7 @@ impl Arena {
     /// Whether the rectangle is usable: finite, with `min < max` on both axes.
     pub fn check(&self) -> Result<(), FieldError> {
         let size = self.size();
-        let within = |v: DVec2| v.is_finite() && v.abs().max_element() <= MAX_MAGNITUDE;
-        if within(self.min) && within(self.max) && size.x > 0.0 && size.y > 0.0 {
+        if in_range(self.min) && in_range(self.max) && size.x > 0.0 && size.y > 0.0 {
             Ok(())
         } else {
             Err(FieldError::new(

@@ -5,7 +5,6 @@
 //! a compact binary form (postcard); read back with a size limit and every value checked, so a
 //! damaged or forged file is an error naming the file, never a panic.
 
-use std::io::Read;
 use std::path::Path;
 
 use bevy::prelude::*;
@@ -13,13 +12,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, snapshot};
+use crate::circle::{CircleState, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
-use crate::components::{Mass, Position, Radius, Tint, Velocity};
 use crate::config::{CirclesConfig, Effects, MAX_CIRCLES, Solver, SpawnConfig};
 use crate::error::InputError;
 use crate::exact::EngineState;
 use crate::exact::engine::EngineSnapshot;
+use crate::io::read_bytes_limited;
 use crate::range::{check_mass, check_vector};
 use crate::run::{Progress, headless_app};
 use crate::schedule::StepTotals;
@@ -82,19 +81,18 @@ impl Checkpoint {
     /// Reads and checks a checkpoint file.
     pub fn read(path: &Path) -> Result<Self, InputError> {
         let origin = path.display().to_string();
-        let mut bytes = Vec::new();
-        std::fs::File::open(path)
-            .and_then(|f| f.take(MAX_CHECKPOINT_BYTES + 1).read_to_end(&mut bytes))
-            .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
-        if bytes.len() as u64 > MAX_CHECKPOINT_BYTES {
-            return Err(InputError::whole(
-                &origin,
-                format!(
-                    "larger than the {} GiB a checkpoint may have",
-                    MAX_CHECKPOINT_BYTES >> 30
-                ),
-            ));
-        }
+        let bytes = std::fs::File::open(path)
+            .and_then(|file| read_bytes_limited(file, MAX_CHECKPOINT_BYTES))
+            .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?
+            .ok_or_else(|| {
+                InputError::whole(
+                    &origin,
+                    format!(
+                        "larger than the {} GiB a checkpoint may have",
+                        MAX_CHECKPOINT_BYTES >> 30
+                    ),
+                )
+            })?;
         Self::from_bytes(&bytes, &origin)
     }
 
@@ -190,22 +188,7 @@ impl Checkpoint {
         world.insert_resource(self.pairs);
         world.insert_resource(self.walls);
         world.resource_mut::<SpawnReport>().requested = self.requested;
-        let circles: Vec<(Entity, CircleState)> = world
-            .query::<(Entity, &Position, &Velocity, &Radius, &Mass, &Tint)>()
-            .iter(world)
-            .map(|(e, p, v, r, m, t)| {
-                (
-                    e,
-                    CircleState {
-                        position: p.0,
-                        velocity: v.0,
-                        radius: r.0,
-                        mass: m.0,
-                        tint: t.0,
-                    },
-                )
-            })
-            .collect();
+        let circles = snapshot_with_entities(world);
         if circles.iter().map(|(_, c)| c).ne(self.circles.iter()) {
             return Err(InputError::whole(
                 origin,

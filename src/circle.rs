@@ -70,14 +70,27 @@ pub fn snapshot(world: &mut World) -> Vec<CircleState> {
     world
         .query::<(&Position, &Velocity, &Radius, &Mass, &Tint)>()
         .iter(world)
-        .map(|(p, v, r, m, t)| CircleState {
-            position: p.0,
-            velocity: v.0,
-            radius: r.0,
-            mass: m.0,
-            tint: t.0,
-        })
+        .map(|(p, v, r, m, t)| from_components(p, v, r, m, t))
         .collect()
+}
+
+/// [`snapshot`] with each circle's entity.
+pub fn snapshot_with_entities(world: &mut World) -> Vec<(Entity, CircleState)> {
+    world
+        .query::<(Entity, &Position, &Velocity, &Radius, &Mass, &Tint)>()
+        .iter(world)
+        .map(|(e, p, v, r, m, t)| (e, from_components(p, v, r, m, t)))
+        .collect()
+}
+
+fn from_components(p: &Position, v: &Velocity, r: &Radius, m: &Mass, t: &Tint) -> CircleState {
+    CircleState {
+        position: p.0,
+        velocity: v.0,
+        radius: r.0,
+        mass: m.0,
+        tint: t.0,
+    }
 }
 
 /// Centres and radii of `circles`: what the broad phase and the overlap queries read.

@@ -17,23 +17,23 @@ pub const MAX_LINE_BYTES: usize = 4096;
 /// file costs at most `limit` bytes of memory before the error. The error says what is wrong,
 /// without the file's name (the caller adds it).
 pub fn read_limited(reader: impl Read, limit: u64) -> Result<String, String> {
-    let mut bytes = Vec::new();
-    reader
-        .take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read: {e}"))?;
-    if bytes.len() as u64 > limit {
-        return Err(format!(
-            "larger than the {} MiB this input may have",
-            limit >> 20
-        ));
-    }
+    let bytes = read_bytes_limited(reader, limit)
+        .map_err(|e| format!("cannot read: {e}"))?
+        .ok_or_else(|| format!("larger than the {} MiB this input may have", limit >> 20))?;
     String::from_utf8(bytes).map_err(|e| {
         format!(
             "not UTF-8 text (byte {} is not valid)",
             e.utf8_error().valid_up_to()
         )
     })
+}
+
+/// All of `reader`'s bytes, or `None` if it has more than `limit` (having read at most one
+/// byte past it).
+pub fn read_bytes_limited(reader: impl Read, limit: u64) -> io::Result<Option<Vec<u8>>> {
+    let mut bytes = Vec::new();
+    reader.take(limit + 1).read_to_end(&mut bytes)?;
+    Ok((bytes.len() as u64 <= limit).then_some(bytes))
 }
 
 /// Where a line could not be read and why: its number and the message.

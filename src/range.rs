@@ -27,19 +27,24 @@ pub fn check_magnitude(field: &str, value: f64) -> Result<(), FieldError> {
     }
 }
 
+/// Whether both components of `value` are finite and at most [`MAX_MAGNITUDE`] in size.
+pub fn in_range(value: DVec2) -> bool {
+    value.is_finite() && value.abs().max_element() <= MAX_MAGNITUDE
+}
+
 /// [`check_magnitude`] for both components of a vector.
 pub fn check_vector(field: &str, value: DVec2) -> Result<(), FieldError> {
-    check_magnitude(field, value.x)
-        .and_then(|()| check_magnitude(field, value.y))
-        .map_err(|_| {
-            FieldError::new(
-                field,
-                format!(
-                    "must be finite and at most {MAX_MAGNITUDE:e} in size, got ({:?}, {:?})",
-                    value.x, value.y
-                ),
-            )
-        })
+    if in_range(value) {
+        Ok(())
+    } else {
+        Err(FieldError::new(
+            field,
+            format!(
+                "must be finite and at most {MAX_MAGNITUDE:e} in size, got ({:?}, {:?})",
+                value.x, value.y
+            ),
+        ))
+    }
 }
 
 /// Checks that `mass` is within [`MIN_MASS`, `MAX_MAGNITUDE`].

@@ -30,27 +30,23 @@ pub fn multi_level_pairs(
     pairs: &mut Vec<(u32, u32)>,
 ) {
     let start = pairs.len();
-    let mut levels: Vec<Level> = Vec::new();
-    for members in split_levels(circles, r_min) {
-        let own: Vec<(DVec2, f64)> = members.iter().map(|&i| circles[i as usize]).collect();
-        let mut cells = CellList::default();
-        let mut local = Vec::new();
-        let max_radius = radius_range(&own).1;
-        single_level_pairs(&mut cells, arena, &own, max_radius, &mut local);
-        pairs.extend(local.into_iter().map(|(a, b)| {
-            let (i, j) = (members[a as usize], members[b as usize]);
-            (i.min(j), i.max(j))
-        }));
-        levels.push(Level {
-            members,
-            cells,
-            max_radius,
-        });
-    }
-    let _ = visit_across_levels(&levels, arena, circles, &mut |i, j| {
+    let mut push = |i: u32, j: u32| {
         pairs.push((i, j));
         ControlFlow::Continue(())
+    };
+    // Within a level, the (parallel for large levels) listing scan.
+    let levels = build_levels(circles, r_min, |cells, own, max_radius, members| {
+        let mut local = Vec::new();
+        single_level_pairs(cells, arena, own, max_radius, &mut local);
+        for (a, b) in local {
+            let (i, j) = (members[a as usize], members[b as usize]);
+            push(i.min(j), i.max(j))?;
+        }
+        ControlFlow::Continue(())
     });
+    if let ControlFlow::Continue(levels) = levels {
+        let _ = visit_across_levels(&levels, arena, circles, &mut push);
+    }
     // A box wider than a periodic grid visits some cells twice; keep each pair once.
     sort_and_dedupe(pairs, start);
 }
@@ -64,22 +60,36 @@ pub fn visit_multi_level(
     r_min: f64,
     visit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
 ) -> ControlFlow<()> {
+    let levels = build_levels(circles, r_min, |cells, own, max_radius, members| {
+        visit_single_level(cells, arena, own, max_radius, &mut |a, b| {
+            let (i, j) = (members[a as usize], members[b as usize]);
+            visit(i.min(j), i.max(j))
+        })
+    })?;
+    visit_across_levels(&levels, arena, circles, visit)
+}
+
+/// The size levels of `circles`, each with its cell list built by `within`, which is handed the
+/// level's cell list, its circles, their largest reach and their indices in `circles`, and
+/// finds the pairs inside the level (stopping everything when it says so).
+fn build_levels(
+    circles: &[(DVec2, f64)],
+    r_min: f64,
+    mut within: impl FnMut(&mut CellList, &[(DVec2, f64)], f64, &[u32]) -> ControlFlow<()>,
+) -> ControlFlow<(), Vec<Level>> {
     let mut levels: Vec<Level> = Vec::new();
     for members in split_levels(circles, r_min) {
         let own: Vec<(DVec2, f64)> = members.iter().map(|&i| circles[i as usize]).collect();
         let mut cells = CellList::default();
         let max_radius = radius_range(&own).1;
-        visit_single_level(&mut cells, arena, &own, max_radius, &mut |a, b| {
-            let (i, j) = (members[a as usize], members[b as usize]);
-            visit(i.min(j), i.max(j))
-        })?;
+        within(&mut cells, &own, max_radius, &members)?;
         levels.push(Level {
             members,
             cells,
             max_radius,
         });
     }
-    visit_across_levels(&levels, arena, circles, visit)
+    ControlFlow::Continue(levels)
 }
 
 /// The indices of `circles` by size level (a factor of 4 in radius per level above `r_min`).
