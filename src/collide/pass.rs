@@ -124,13 +124,26 @@ pub fn resolve_all_contacts(
             stats.virial += (a.radius + b.radius) * outcome.impulse;
         }
     }
-    // Only circles in a pair can have moved.
+    // Only circles in a pair can have moved. Separation may push a circle deep into a wall;
+    // one pushed so far that its centre left the arena is put back (the boundary's rule for a
+    // circle past a wall, position only), so a step never ends with a centre outside.
     for &(k, l) in pairs.iter() {
         for k in [k as usize, l as usize] {
-            discs[order[k] as usize].0 = sorted[k].0;
+            let (position, radius) = &mut sorted[k];
+            if !arena.is_periodic() && !arena.contains(*position) {
+                put_back_inside(position, *radius, arena);
+            }
+            discs[order[k] as usize].0 = *position;
         }
     }
     stats
+}
+
+/// Mirrors a centre past a wall back inside `arena` as a bounce would, leaving any velocity
+/// alone.
+fn put_back_inside(position: &mut DVec2, radius: f64, arena: &Arena) {
+    let mut at_rest = DVec2::ZERO;
+    reflect_off_walls(position, &mut at_rest, radius, arena, 1.0);
 }
 
 /// Pushes overlapping circles apart (positions only, split by inverse mass, kept inside the
@@ -150,13 +163,37 @@ pub fn separate_overlaps(circles: &mut [CircleState], arena: &Arena) {
             if arena.is_periodic() {
                 p = arena.wrap(p);
             } else {
-                let mut at_rest = DVec2::ZERO;
-                reflect_off_walls(&mut p, &mut at_rest, c.radius, arena, 1.0);
+                put_back_inside(&mut p, c.radius, arena);
             }
             c.position = p;
         }
         if stats.contacts == 0 {
             break;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arena::Boundary;
+
+    #[test]
+    fn separation_never_pushes_a_centre_out_of_the_arena() {
+        // A light circle on the floor under a heavy one sunk deep into it: split by inverse
+        // mass, nearly all of the 1.9 r of overlap moves the light one, 0.9 r past the floor.
+        let arena = Arena::unit_square(Boundary::Walls);
+        let r = 0.1;
+        let mut scratch = ContactScratch::default();
+        scratch.push(DVec2::new(0.5, r), DVec2::ZERO, r, 1.0);
+        scratch.push(DVec2::new(0.5, 1.1 * r), DVec2::new(0.0, -1.0), r, 1e6);
+        resolve_all_contacts(&mut scratch, &arena, 1.0);
+        for i in 0..2 {
+            assert!(
+                arena.contains(scratch.position(i)),
+                "circle {i} at {}",
+                scratch.position(i)
+            );
         }
     }
 }
