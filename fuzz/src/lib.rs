@@ -1,0 +1,177 @@
+//! What the fuzz targets check, one function per target, so that the targets in `fuzz_targets/`
+//! are one line each and a crash found by one replays with the same checks. A check that fails
+//! panics, which libFuzzer reports as a crash and saves the input under `artifacts/`.
+//!
+//! - [`particles`]: any bytes as a particle file, under both boundaries.
+//! - [`scene`]: any bytes as a scene file (read with the scene limit, RON, every value checked).
+//! - [`simulate`]: what either reader accepts, run for a few steps under every solver.
+
+use moving_circles::arena::{Arena, Boundary};
+use moving_circles::circle::CircleState;
+use moving_circles::config::{CirclesConfig, MAX_CIRCLES, Solver};
+use moving_circles::error::InputError;
+use moving_circles::io::{MAX_SCENE_BYTES, read_limited};
+use moving_circles::run::{Report, headless_app, run_steps};
+use moving_circles::scene::check::{check_circle, first_overlap};
+use moving_circles::scene::{Scene, particles as particle_file};
+
+/// Most circles [`simulate`] runs: inputs asking for more are only read and checked. With
+/// [`SIMULATED_STEPS`] this bounds an execution: `exact` processes at most
+/// [`EXACT_EVENTS_PER_CIRCLE`](moving_circles::exact::EXACT_EVENTS_PER_CIRCLE) events per
+/// circle and step (reached only by inelastic collapse or speeds that cross the arena billions
+/// of times a step), so the slowest input costs about 7 M events, a few seconds in the
+/// instrumented build; most cost a millisecond.
+pub const MAX_SIMULATED_CIRCLES: usize = 16;
+
+/// Steps [`simulate`] runs under each solver.
+pub const SIMULATED_STEPS: u64 = 4;
+
+/// Overlap, in smaller radii, that is rounding and not penetration (as in the hard cases).
+const ROUNDING: f64 = 1e-9;
+
+/// The solvers [`simulate`] runs, one of each kind.
+const SOLVERS: [Solver; 4] = [
+    Solver::Exact,
+    Solver::Swept,
+    Solver::Substeps(3),
+    Solver::Discrete,
+];
+
+/// Any bytes as a particle file: refused with a clear one-line error, or accepted as circles
+/// that pass every check and that the writer writes back to the same circles.
+pub fn particles(data: &[u8]) {
+    for boundary in [Boundary::Walls, Boundary::Periodic] {
+        let _ = read_particles(data, boundary);
+    }
+}
+
+/// Any bytes as a scene file: refused with a clear one-line error, or accepted as a
+/// configuration whose every value passes the checks again.
+pub fn scene(data: &[u8]) {
+    let _ = read_scene(data);
+}
+
+/// The first byte chooses the reader (even: scene; odd: particle file, bit 1 the boundary), the
+/// rest is the file. What the reader accepts, if small enough, runs for [`SIMULATED_STEPS`]
+/// under every solver: no panic, no circle non-finite or outside the arena, every report
+/// number finite, and under `exact` and `swept` no overlap beyond rounding unless the step's
+/// event budget ran out (which the report counts). `substeps=N` and `discrete` promise no bound
+/// on overlap for arbitrary inputs: tunnelling and overlap are what they trade for speed.
+pub fn simulate(data: &[u8]) {
+    let Some((&selector, file)) = data.split_first() else {
+        return;
+    };
+    let config = if selector % 2 == 0 {
+        read_scene(file)
+    } else {
+        let boundary = if selector & 2 == 0 {
+            Boundary::Walls
+        } else {
+            Boundary::Periodic
+        };
+        read_particles(file, boundary).map(|circles| particle_file::to_config(circles, boundary))
+    };
+    let Some(config) = config else {
+        return;
+    };
+    if config.circles.len() + config.spawn.target_count(&config.arena) > MAX_SIMULATED_CIRCLES {
+        return;
+    }
+    for solver in SOLVERS {
+        let report = run(&config, solver);
+        check_report(&report, solver);
+    }
+}
+
+/// Reads `data` as a particle file and checks what came of it.
+fn read_particles(data: &[u8], boundary: Boundary) -> Option<Vec<CircleState>> {
+    let circles = match particle_file::parse_from(data, ORIGIN, boundary) {
+        Ok(circles) => circles,
+        Err(error) => return refused(&error),
+    };
+    let arena = Arena::unit_square(boundary);
+    assert!(circles.len() <= MAX_CIRCLES);
+    check_circles(&circles, &arena);
+    let written = particle_file::format(&circles);
+    let again = particle_file::parse(&written, ORIGIN, boundary)
+        .unwrap_or_else(|e| panic!("the writer's own text is refused: {e}\n{written}"));
+    assert_eq!(again, circles, "written and read back differently");
+    Some(circles)
+}
+
+/// Reads `data` as a scene file and checks what came of it.
+fn read_scene(data: &[u8]) -> Option<CirclesConfig> {
+    let read = read_limited(data, MAX_SCENE_BYTES)
+        .map_err(|message| InputError::whole(ORIGIN, message))
+        .and_then(|text| Scene::parse(&text, ORIGIN)?.to_config(ORIGIN));
+    let config = match read {
+        Ok(config) => config,
+        Err(error) => return refused(&error),
+    };
+    if let Err(e) = config.check() {
+        panic!("an accepted scene fails its own check: {e}");
+    }
+    check_circles(&config.circles, &config.arena);
+    Some(config)
+}
+
+/// The name inputs are read under; errors must start with it.
+const ORIGIN: &str = "fuzz.in";
+
+/// A refusal must be one line, name the input, and carry no raw control byte.
+fn refused<T>(error: &InputError) -> Option<T> {
+    let text = error.to_string();
+    assert!(
+        text.starts_with(ORIGIN),
+        "error does not name the input: {text}"
+    );
+    assert!(
+        !text.chars().any(char::is_control),
+        "raw control byte in: {text:?}"
+    );
+    None
+}
+
+/// Accepted circles are each valid and do not overlap.
+fn check_circles(circles: &[CircleState], arena: &Arena) {
+    for (i, circle) in circles.iter().enumerate() {
+        if let Err(e) = check_circle(circle, arena) {
+            panic!("accepted circle {i} fails its check: {e}");
+        }
+    }
+    if let Some((i, j, depth)) = first_overlap(circles, arena) {
+        panic!("accepted circles {i} and {j} overlap by {depth:e}");
+    }
+}
+
+/// Runs `config` under `solver` for [`SIMULATED_STEPS`], sampling every step.
+fn run(config: &CirclesConfig, solver: Solver) -> Report {
+    let mut app = headless_app(CirclesConfig {
+        solver,
+        ..config.clone()
+    });
+    run_steps(&mut app, ORIGIN, SIMULATED_STEPS, 1, |_| {})
+}
+
+/// The promises every run keeps, and those of the continuous solvers.
+fn check_report(report: &Report, solver: Solver) {
+    assert_eq!(
+        report.non_finite, 0,
+        "{solver}: non-finite circles: {report:?}"
+    );
+    assert!(
+        report.is_finite(),
+        "{solver}: non-finite report: {report:?}"
+    );
+    assert_eq!(
+        report.escaped, 0,
+        "{solver}: circles left the arena: {report:?}"
+    );
+    if solver.is_continuous() && report.budget_exhausted == 0 {
+        assert!(
+            report.max_penetration <= ROUNDING,
+            "{solver}: overlap {:e} beyond rounding: {report:?}",
+            report.max_penetration
+        );
+    }
+}
