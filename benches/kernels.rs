@@ -67,7 +67,7 @@ fn contact_pass(c: &mut Criterion) {
                 for c in &circles {
                     scratch.push(c.position, c.velocity, c.radius, c.mass);
                 }
-                black_box(resolve_all_contacts(&mut scratch, &arena, 1.0))
+                black_box(resolve_all_contacts(&mut scratch, &arena, 1.0, None))
             })
         });
     }

@@ -1,7 +1,7 @@
 //! Whole-App benchmarks: one `app.update()` (exactly one fixed step) of a headless app, after
 //! `finish()`, spawning and one warm-up step. Per solver on gases of growing N, and the price of
 //! effects: a no-collision scene against the same scene with collisions and against bare
-//! integration.
+//! integration; and collision messages off and on.
 //!
 //! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver and
 //! N = 1M for `discrete`.
@@ -73,5 +73,26 @@ fn effects(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, solvers, effects);
+/// What collision messages cost: a walled 10k gas with collisions, messages off and on, under
+/// `discrete` and `exact` (off, there is no extra system and nothing is recorded).
+fn hit_messages(c: &mut Criterion) {
+    let n = 10_000;
+    for solver in [Solver::Discrete, Solver::Exact] {
+        for on in [false, true] {
+            let config = gas(n, solver);
+            let config = CirclesConfig {
+                arena: config.arena.with_boundary(Boundary::Walls),
+                effects: Effects {
+                    hit_messages: on,
+                    ..config.effects
+                },
+                ..config
+            };
+            let name = format!("{solver}/{}", if on { "on" } else { "off" });
+            bench_config(c, "step_hit_messages", BenchmarkId::new(name, n), n, config);
+        }
+    }
+}
+
+criterion_group!(benches, solvers, effects, hit_messages);
 criterion_main!(benches);

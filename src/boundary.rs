@@ -1,7 +1,8 @@
 //! The arena's edges: [`WallsPlugin`], walls with the seed's reflection rule in vector form
 //! ([`reflect_off_walls`], a plain function), or [`PeriodicPlugin`], wrap-around; both in
 //! [`CircleSystems::Boundary`] of the discrete solvers. Wall hits are counted here
-//! ([`WallCollisions`]), by whichever solver makes them.
+//! ([`WallCollisions`]), by whichever solver makes them, and written as
+//! [`WallHit`] messages when the scene asks for them.
 //!
 //! Per axis: a circle whose edge is past a wall and that moves outward is mirrored back inside
 //! and its normal velocity flipped; one that is past a wall but already moving inward (pushed
@@ -12,10 +13,12 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
-use crate::components::{Mass, Position, Radius, Velocity};
+use crate::collide::contact::combine_restitution;
+use crate::components::{Mass, Position, Radius, Restitution, Velocity};
 use crate::config::Effects;
 use crate::effects::{Effect, register_effect};
-use crate::schedule::{CircleStep, CircleSystems};
+use crate::hits::{ArenaWall, HitLog, WallHit};
+use crate::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
 
 /// Keeps every circle inside the [`Arena`] by reflecting it off the walls, when the arena has
 /// walls. (The continuous solvers hit the walls inside their own step.)
@@ -24,7 +27,8 @@ pub struct WallsPlugin;
 
 impl Plugin for WallsPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<WallCollisions>();
+        app.init_resource::<WallCollisions>()
+            .add_message::<WallHit>();
         register_effect(app, Effect::Walls, &[CircleStep.intern()], || {
             bounce_off_walls
                 .in_set(CircleSystems::Boundary)
@@ -91,8 +95,20 @@ pub fn reflect_off_walls(
     arena: &Arena,
     restitution: f64,
 ) -> u64 {
-    let mut hits: u64 = 0;
-    for axis in 0..2 {
+    let [x, y] = reflect_off_walls_per_axis(position, velocity, radius, arena, restitution);
+    x.saturating_add(y)
+}
+
+/// [`reflect_off_walls`], with the hits on the x walls and on the y walls apart.
+pub fn reflect_off_walls_per_axis(
+    position: &mut DVec2,
+    velocity: &mut DVec2,
+    radius: f64,
+    arena: &Arena,
+    restitution: f64,
+) -> [u64; 2] {
+    let mut hits = [0; 2];
+    for (axis, hits) in hits.iter_mut().enumerate() {
         let lo = arena.min[axis] + radius;
         let hi = arena.max[axis] - radius;
         let n = reflect_axis(&mut position[axis], &mut velocity[axis], lo, hi);
@@ -100,7 +116,7 @@ pub fn reflect_off_walls(
             // Past 2³¹ bounces any restitution below 1 has long rounded the speed to zero.
             velocity[axis] *= restitution.powi(n.min(i32::MAX as u64) as i32);
         }
-        hits = hits.saturating_add(n);
+        *hits = n;
     }
     hits
 }
@@ -144,22 +160,52 @@ fn reflect_axis(p: &mut f64, v: &mut f64, lo: f64, hi: f64) -> u64 {
     crossings.max(1)
 }
 
-/// Applies [`reflect_off_walls`] to every circle, counts the hits and adds the momentum the
-/// walls took up (`Σ m |Δv|`, for the wall pressure).
+/// The circles as the wall bounce reads and writes them.
+type Circles<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static mut Position,
+        &'static mut Velocity,
+        &'static Radius,
+        &'static Mass,
+        Option<&'static Restitution>,
+    ),
+>;
+
+/// Applies [`reflect_off_walls`] to every circle (with its own restitution combined with the
+/// walls', if it has one), counts the hits and adds the momentum the walls took up
+/// (`Σ m |Δv|`, for the wall pressure); with `effects.hit_messages`, writes a [`WallHit`] per
+/// wall hit.
 fn bounce_off_walls(
     arena: Res<Arena>,
     effects: Res<Effects>,
+    clock: (Res<StepDt>, Res<SubstepStart>),
     mut walls: ResMut<WallCollisions>,
-    mut circles: Query<(&mut Position, &mut Velocity, &Radius, &Mass)>,
+    mut log: Local<(HitLog, Vec<Entity>)>,
+    mut messages: MessageWriter<WallHit>,
+    mut circles: Circles,
 ) {
+    let (log, entities) = &mut *log;
     let mut hits = 0u64;
     let mut impulse = 0.0f64;
-    for (mut position, mut velocity, radius, mass) in &mut circles {
+    for (entity, mut position, mut velocity, radius, mass, own) in &mut circles {
         let (mut p, mut v) = (position.0, velocity.0);
-        let n = reflect_off_walls(&mut p, &mut v, radius.0, &arena, effects.wall_restitution);
+        let e = own.map_or(effects.wall_restitution, |own| {
+            combine_restitution(own.0, effects.wall_restitution)
+        });
+        let per_axis = reflect_off_walls_per_axis(&mut p, &mut v, radius.0, &arena, e);
+        let n = per_axis[0].saturating_add(per_axis[1]);
         if n > 0 || p != position.0 {
             if n > 0 && mass.0.is_finite() {
                 impulse += mass.0 * (v - velocity.0).length();
+            }
+            if n > 0 && effects.hit_messages {
+                let i = entities.len() as u32;
+                entities.push(entity);
+                let before = (position.0, velocity.0);
+                record_wall_hits(log, i, before, (p, v), per_axis, (radius.0, mass.0), &arena);
             }
             position.0 = p;
             velocity.0 = v;
@@ -168,6 +214,48 @@ fn bounce_off_walls(
     }
     walls.count = walls.count.saturating_add(hits);
     walls.impulse += impulse;
+    if effects.hit_messages {
+        let (dt, start) = clock;
+        log.send_wall_hits(|i| entities[i as usize], start.0 + dt.0, &mut messages);
+        entities.clear();
+    }
+}
+
+/// Records the wall hits of circle `i` (of radius and mass `body`), which one reflection took
+/// from state `before` to `after`, `per_axis` hits on each axis.
+fn record_wall_hits(
+    log: &mut HitLog,
+    i: u32,
+    before: (DVec2, DVec2),
+    after: (DVec2, DVec2),
+    per_axis: [u64; 2],
+    body: (f64, f64),
+    arena: &Arena,
+) {
+    let (radius, mass) = body;
+    for (axis, &count) in per_axis.iter().enumerate() {
+        if count == 0 {
+            continue;
+        }
+        // The first wall is the one overshot; each further crossing hits the other one.
+        let first_high = before.0[axis] > arena.max[axis] - radius;
+        let wall = ArenaWall::on_axis(axis, first_high == (count % 2 == 1));
+        let (point, normal) = wall.contact(after.0, arena);
+        log.walls.push(WallHit {
+            circle: i,
+            wall,
+            point,
+            normal,
+            impulse: if mass.is_finite() {
+                mass * (after.1[axis] - before.1[axis]).abs()
+            } else {
+                f64::INFINITY
+            },
+            normal_speed: before.1[axis].abs(),
+            time: 0.0,
+            count,
+        });
+    }
 }
 
 #[cfg(test)]

@@ -1,4 +1,5 @@
-//! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass` and `Tint`.
+//! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass` and `Tint`, and
+//! the optional `Restitution`.
 //!
 //! `Position` is deliberately not `Transform`: the simulation owns it, and the render side copies
 //! it into `Transform` only when rendering is on. Inserting a [`Radius`] is what makes an entity a
@@ -46,6 +47,14 @@ impl Mass {
         }
     }
 }
+
+/// A circle's own coefficient of restitution, in `[0, 1]`; without it a circle takes the
+/// scene's (`effects.restitution` against circles, `effects.wall_restitution` against walls).
+/// Two values meet as their minimum ([`combine_restitution`](crate::collide::contact::combine_restitution)),
+/// against other circles and walls alike, under every solver.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Debug)]
+pub struct Restitution(pub f64);
 
 /// Display colour of a circle as sRGB bytes, as in the plain-text particle format (`r g b`).
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Eq, Deref, DerefMut)]

@@ -16,6 +16,7 @@ pub mod error;
 pub mod exact;
 pub mod forces;
 pub mod grid;
+pub mod hits;
 pub mod integrate;
 pub mod io;
 pub mod range;
@@ -46,19 +47,20 @@ pub mod prelude {
     pub use crate::boundary::{PeriodicPlugin, WallCollisions, WallsPlugin};
     pub use crate::circle::CircleState;
     pub use crate::collide::{CollidePlugin, PairCollisions};
-    pub use crate::components::{Mass, Position, Radius, Tint, Velocity};
+    pub use crate::components::{Mass, Position, Radius, Restitution, Tint, Velocity};
     pub use crate::config::{CirclesConfig, Effects, MassModel, Solver, SpawnConfig};
     pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin};
     pub use crate::effects::Effect;
     pub use crate::exact::ContinuousPlugin;
     pub use crate::forces::{DragPlugin, GravityPlugin};
+    pub use crate::hits::{ArenaWall, CircleHit, WallHit};
     pub use crate::integrate::IntegratePlugin;
     pub use crate::scene::Scene;
     pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
 }
 
-pub use components::{Mass, Position, Radius, Tint, Velocity};
+pub use components::{Mass, Position, Radius, Restitution, Tint, Velocity};
 pub use schedule::CircleSystems;
 
 /// The simulation as a plugin group: [`StepPlugin`] (first: the others build on it),

@@ -53,6 +53,11 @@ pub struct ContinuousStep;
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
 pub struct StepDt(pub f64);
 
+/// Seconds from the start of the fixed step to the start of the running (sub)step: what a hit
+/// found in a substep adds to its time.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
+pub struct SubstepStart(pub f64);
+
 /// Fixed steps advanced and the simulated time they covered, since the last (re)spawn.
 #[derive(
     Resource, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
@@ -101,6 +106,7 @@ impl Plugin for StepPlugin {
                 self.dt,
             )))
             .init_resource::<StepDt>()
+            .init_resource::<SubstepStart>()
             .init_resource::<StepTotals>()
             .init_schedule(CircleStep)
             .init_schedule(ContinuousStep)
@@ -152,11 +158,14 @@ fn run_circle_step(world: &mut World) {
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
     if solver.is_continuous() {
         world.resource_mut::<StepDt>().0 = dt;
+        world.resource_mut::<SubstepStart>().0 = 0.0;
         world.run_schedule(ContinuousStep);
     } else {
         let substeps = solver.substeps();
-        world.resource_mut::<StepDt>().0 = dt / f64::from(substeps);
-        for _ in 0..substeps {
+        let sub_dt = dt / f64::from(substeps);
+        world.resource_mut::<StepDt>().0 = sub_dt;
+        for k in 0..substeps {
+            world.resource_mut::<SubstepStart>().0 = f64::from(k) * sub_dt;
             world.run_schedule(CircleStep);
         }
     }

@@ -15,6 +15,25 @@ pub struct ContactOutcome {
     /// Magnitude of the impulse applied (0 if the pair was not approaching). Non-zero means a
     /// collision to count; `(r_a + r_b) · impulse` summed over collisions gives the virial.
     pub impulse: f64,
+    /// Unit normal from `a` to `b` (zero if apart).
+    pub normal: DVec2,
+    /// Speed at which the pair approached along the normal before the impulse (0 if apart or
+    /// separating).
+    pub normal_speed: f64,
+}
+
+/// The restitution of a hit between two surfaces of restitution `a` and `b`: the smaller one
+/// (the deader surface decides), so a circle without its own value, which takes the scene's,
+/// never makes a pair bouncier than the scene asks. Walls combine with circles the same way.
+///
+/// ```
+/// use moving_circles::collide::contact::combine_restitution;
+///
+/// assert_eq!(combine_restitution(1.0, 0.3), 0.3);
+/// ```
+#[inline]
+pub fn combine_restitution(a: f64, b: f64) -> f64 {
+    a.min(b)
 }
 
 /// The unit contact normal along `d` (from the first circle to the second) and `|d|`.
@@ -88,15 +107,19 @@ pub fn resolve_contact(
         // Two immovable circles: nothing can move.
         return ContactOutcome {
             penetration,
-            impulse: 0.0,
+            normal: n,
+            ..ContactOutcome::default()
         };
     }
     a.position -= n * (overlap * wa / total_inv_mass);
     b.position += n * (overlap * wb / total_inv_mass);
+    let approach = (a.velocity - b.velocity).dot(n);
     let impulse = apply_impulse(n, &mut a.velocity, &mut b.velocity, wa, wb, restitution);
     ContactOutcome {
         penetration,
         impulse: impulse.unwrap_or(0.0),
+        normal: n,
+        normal_speed: if impulse.is_some() { approach } else { 0.0 },
     }
 }
 
@@ -113,6 +136,7 @@ mod tests {
         let (mut a, mut b) = (body(0.0, 0.0, 1.0, 0.0), body(0.9, 0.0, -2.0, 0.0));
         let out = resolve_contact(&mut a, &mut b, 1.0);
         assert_eq!(out.impulse, 3.0, "j = (1 + e)·|v_rel| / (2/m) = 2·3/2");
+        assert_eq!((out.normal, out.normal_speed), (DVec2::X, 3.0));
         assert!((out.penetration - 0.2).abs() < 1e-6);
         assert_eq!(a.velocity, DVec2::new(-2.0, 0.0));
         assert_eq!(b.velocity, DVec2::new(1.0, 0.0));

@@ -14,10 +14,11 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
-use crate::components::{Mass, Position, Radius, Velocity};
+use crate::components::{Mass, Position, Radius, Restitution, Velocity};
 use crate::config::Effects;
 use crate::effects::{Effect, register_effect};
-use crate::schedule::{CircleStep, CircleSystems};
+use crate::hits::{CircleHit, HitLog};
+use crate::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
 use pass::{ContactScratch, resolve_all_contacts};
 
 /// Resolves overlaps between circles: separation plus restitution impulse (`effects.restitution`),
@@ -28,7 +29,8 @@ pub struct CollidePlugin;
 
 impl Plugin for CollidePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<PairCollisions>();
+        app.init_resource::<PairCollisions>()
+            .add_message::<CircleHit>();
         register_effect(app, Effect::Collisions, &[CircleStep.intern()], || {
             collide_circles
                 .in_set(CircleSystems::Collide)
@@ -48,26 +50,59 @@ pub struct PairCollisions {
     pub virial: f64,
 }
 
+/// The circles as the contact pass reads and writes them.
+type Circles<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static mut Position,
+        &'static mut Velocity,
+        &'static Radius,
+        &'static Mass,
+        Option<&'static Restitution>,
+    ),
+>;
+
 /// Gathers the circles, resolves their contacts with [`resolve_all_contacts`] and writes back
-/// what changed.
+/// what changed; with `effects.hit_messages`, writes a [`CircleHit`] per collision.
+#[allow(clippy::too_many_arguments)]
 fn collide_circles(
     arena: Res<Arena>,
     effects: Res<Effects>,
+    clock: (Res<StepDt>, Res<SubstepStart>),
     mut counted: ResMut<PairCollisions>,
     mut scratch: Local<ContactScratch>,
-    mut circles: Query<(&mut Position, &mut Velocity, &Radius, &Mass)>,
+    mut log: Local<(HitLog, Vec<Entity>)>,
+    mut messages: MessageWriter<CircleHit>,
+    own_restitution: Query<(), With<Restitution>>,
+    mut circles: Circles,
 ) {
     scratch.clear();
-    for (p, v, r, m) in &circles {
+    let (log, entities) = &mut *log;
+    entities.clear();
+    let per_circle = !own_restitution.is_empty();
+    for (e, p, v, r, m, own) in &circles {
         scratch.push(p.0, v.0, r.0, m.0);
+        if per_circle {
+            scratch.push_restitution(own.map_or(effects.restitution, |own| own.0));
+        }
+        if effects.hit_messages {
+            entities.push(e);
+        }
     }
-    let stats = resolve_all_contacts(&mut scratch, &arena, effects.restitution);
+    let record = effects.hit_messages.then_some(&mut *log);
+    let stats = resolve_all_contacts(&mut scratch, &arena, effects.restitution, record);
     counted.count += stats.collisions;
     counted.virial += stats.virial;
+    if effects.hit_messages {
+        let (dt, start) = clock;
+        log.send_circle_hits(|i| entities[i as usize], start.0 + dt.0, &mut messages);
+    }
     if stats.contacts == 0 {
         return;
     }
-    for (i, (mut p, mut v, _, _)) in circles.iter_mut().enumerate() {
+    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
         let mut position = scratch.position(i);
         if arena.is_periodic() && !arena.contains(position) {
             position = arena.wrap(position);

@@ -8,10 +8,11 @@ use bevy::math::DVec2;
 use super::broad_phase::{
     CellList, needs_levels, overlapping_pairs, pairs_in_cell_order, radius_range,
 };
-use super::contact::resolve_contact;
+use super::contact::{combine_restitution, resolve_contact};
 use crate::arena::Arena;
 use crate::boundary::reflect_off_walls;
 use crate::circle::CircleState;
+use crate::hits::{CircleHit, HitLog};
 
 /// The circles of one collision pass, and buffers reused from pass to pass so the hot path
 /// does not allocate. Centres and radii sit together (what the broad phase reads); velocities
@@ -21,6 +22,8 @@ pub struct ContactScratch {
     discs: Vec<(DVec2, f64)>,
     velocities: Vec<DVec2>,
     masses: Vec<f64>,
+    /// Each circle's own restitution, or empty when every circle takes the pass's.
+    restitutions: Vec<f64>,
     /// `discs` in cell order, while contacts are resolved.
     sorted: Vec<(DVec2, f64)>,
     /// `0, 1, 2, …`: the order of the multi-level path, which resolves in input order.
@@ -35,6 +38,7 @@ impl ContactScratch {
         self.discs.clear();
         self.velocities.clear();
         self.masses.clear();
+        self.restitutions.clear();
     }
 
     /// Adds a circle to the next [`resolve_all_contacts`].
@@ -43,6 +47,13 @@ impl ContactScratch {
         self.discs.push((position, radius));
         self.velocities.push(velocity);
         self.masses.push(mass);
+    }
+
+    /// Gives the circle pushed last its own restitution. Either every circle gets one (pushed
+    /// right after it) or none does; a pair then bounces with [`combine_restitution`] of theirs.
+    #[inline]
+    pub fn push_restitution(&mut self, restitution: f64) {
+        self.restitutions.push(restitution);
     }
 
     /// Centre of circle `i` now.
@@ -68,7 +79,8 @@ pub struct PassStats {
 }
 
 /// Finds and resolves all overlapping pairs among the circles in `scratch`, in the broad
-/// phase's scan order.
+/// phase's scan order, with `restitution` (or the circles' own, if they have theirs). Each
+/// collision is recorded in `hits` if given (circle indices in push order, time 0).
 ///
 /// Circles of similar size are found in cell order ([`pairs_in_cell_order`]) and their centres
 /// are corrected in that order, on nearby memory; radii spanning decades go through the
@@ -77,11 +89,13 @@ pub fn resolve_all_contacts(
     scratch: &mut ContactScratch,
     arena: &Arena,
     restitution: f64,
+    mut hits: Option<&mut HitLog>,
 ) -> PassStats {
     let ContactScratch {
         discs,
         velocities,
         masses,
+        restitutions,
         sorted,
         identity,
         pairs,
@@ -115,13 +129,29 @@ pub fn resolve_all_contacts(
         let image = a.position + arena.offset(a.position, sorted[l].0);
         let shift = sorted[l].0 - image;
         let mut b = circle((image, sorted[l].1), velocities[j], masses[j]);
-        let outcome = resolve_contact(&mut a, &mut b, restitution);
+        let e = if restitutions.is_empty() {
+            restitution
+        } else {
+            combine_restitution(restitutions[i], restitutions[j])
+        };
+        let outcome = resolve_contact(&mut a, &mut b, e);
         (sorted[k].0, velocities[i]) = (a.position, a.velocity);
         (sorted[l].0, velocities[j]) = (b.position + shift, b.velocity);
         stats.contacts += u64::from(outcome.penetration > 0.0);
         if outcome.impulse > 0.0 {
             stats.collisions += 1;
             stats.virial += (a.radius + b.radius) * outcome.impulse;
+            if let Some(log) = hits.as_deref_mut() {
+                log.circles.push(CircleHit {
+                    a: i as u32,
+                    b: j as u32,
+                    point: a.position + outcome.normal * a.radius,
+                    normal: outcome.normal,
+                    impulse: outcome.impulse,
+                    normal_speed: outcome.normal_speed,
+                    time: 0.0,
+                });
+            }
         }
     }
     // Only circles in a pair can have moved. Separation may push a circle deep into a wall;
@@ -157,7 +187,7 @@ pub fn separate_overlaps(circles: &mut [CircleState], arena: &Arena) {
             // No velocities: no impulses, only positions move.
             scratch.push(c.position, DVec2::ZERO, c.radius, c.mass);
         }
-        let stats = resolve_all_contacts(&mut scratch, arena, 1.0);
+        let stats = resolve_all_contacts(&mut scratch, arena, 1.0, None);
         for (i, c) in circles.iter_mut().enumerate() {
             let mut p = scratch.position(i);
             if arena.is_periodic() {
@@ -187,7 +217,7 @@ mod tests {
         let mut scratch = ContactScratch::default();
         scratch.push(DVec2::new(0.5, r), DVec2::ZERO, r, 1.0);
         scratch.push(DVec2::new(0.5, 1.1 * r), DVec2::new(0.0, -1.0), r, 1e6);
-        resolve_all_contacts(&mut scratch, &arena, 1.0);
+        resolve_all_contacts(&mut scratch, &arena, 1.0, None);
         for i in 0..2 {
             assert!(
                 arena.contains(scratch.position(i)),

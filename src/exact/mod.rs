@@ -21,8 +21,9 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::CircleState;
 use crate::collide::PairCollisions;
-use crate::components::{Mass, Position, Radius, Velocity};
+use crate::components::{Mass, Position, Radius, Restitution, Velocity};
 use crate::config::{Effects, Solver};
+use crate::hits::{CircleHit, WallHit};
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
 use engine::{EngineSnapshot, EventEngine, EventStats};
 
@@ -40,6 +41,8 @@ impl Plugin for ContinuousPlugin {
         app.init_resource::<EngineState>()
             .init_resource::<PairCollisions>()
             .init_resource::<WallCollisions>()
+            .add_message::<CircleHit>()
+            .add_message::<WallHit>()
             .add_systems(
                 ContinuousStep,
                 (gather_into_engine, advance_engine, write_back)
@@ -56,6 +59,8 @@ pub struct EngineState {
     engine: Option<EventEngine>,
     entities: Vec<Entity>,
     written: Vec<(DVec2, DVec2)>,
+    /// The circles' own restitutions the engine was built with (empty if none had one).
+    own_restitution: Vec<f64>,
     setup: Option<(Arena, Effects, Solver)>,
     last_stats: EventStats,
     /// Steps whose event budget ran out (their remainder was free flight).
@@ -85,13 +90,14 @@ impl EngineState {
     ) -> Result<(), String> {
         let (arena, effects) = setup;
         let states: Vec<CircleState> = circles.iter().map(|&(_, c)| c).collect();
-        let engine = EventEngine::restore(
+        let mut engine = EventEngine::restore(
             snapshot,
             &states,
             &arena,
             effects.restitution,
             effects.wall_restitution,
         )?;
+        engine.record_hits(effects.hit_messages);
         if let Some(i) = (0..engine.len()).find(|&i| engine.position(i) != states[i].position) {
             return Err(format!(
                 "engine state of circle {i} puts it elsewhere than the circle"
@@ -117,6 +123,7 @@ type Circles<'w, 's> = Query<
         &'static mut Velocity,
         &'static Radius,
         &'static Mass,
+        Option<&'static Restitution>,
     ),
 >;
 
@@ -127,31 +134,42 @@ fn gather_into_engine(
     arena: Res<Arena>,
     effects: Res<Effects>,
     mut state: ResMut<EngineState>,
+    own_restitution: Query<(), With<Restitution>>,
     circles: Circles,
 ) {
     let state = &mut *state;
     let setup = (*arena, *effects, *solver);
+    let own: Vec<f64> = if own_restitution.is_empty() {
+        Vec::new()
+    } else {
+        let scene = effects.restitution;
+        circles.iter().map(|c| c.5.map_or(scene, |e| e.0)).collect()
+    };
     let unchanged = *solver == Solver::Exact
         && state.engine.is_some()
         && state.setup == Some(setup)
+        && state.own_restitution == own
         && circles.iter().len() == state.entities.len()
         && circles
             .iter()
             .zip(state.entities.iter().zip(&state.written))
-            .all(|((e, p, v, _, _), (&we, &(wp, wv)))| e == we && p.0 == wp && v.0 == wv);
+            .all(|((e, p, v, ..), (&we, &(wp, wv)))| e == we && p.0 == wp && v.0 == wv);
     if unchanged {
         return;
     }
     let bodies: Vec<CircleState> = circles
         .iter()
-        .map(|(_, p, v, r, m)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
+        .map(|(_, p, v, r, m, _)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
         .collect();
-    let engine = EventEngine::new(
+    let mut engine = EventEngine::new(
         &bodies,
         &arena,
         effects.restitution,
         effects.wall_restitution,
     );
+    engine.set_own_restitutions(own.clone());
+    engine.record_hits(effects.hit_messages);
+    state.own_restitution = own;
     state.last_stats = engine.stats();
     state.engine = Some(engine);
     state.entities = circles.iter().map(|(e, ..)| e).collect();
@@ -159,13 +177,14 @@ fn gather_into_engine(
     state.rebuilds += 1;
 }
 
-/// Processes the step's events (within the solver's budget) and counts what they did.
+/// Processes the step's events (within the solver's budget), counts what they did and, when
+/// recording, writes their hits as messages.
 fn advance_engine(
     solver: Res<Solver>,
     dt: Res<StepDt>,
     mut state: ResMut<EngineState>,
-    mut pairs: ResMut<PairCollisions>,
-    mut walls: ResMut<WallCollisions>,
+    mut counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
+    mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
 ) {
     let state = &mut *state;
     let Some(engine) = state.engine.as_mut() else {
@@ -176,11 +195,18 @@ fn advance_engine(
         _ => EXACT_EVENTS_PER_CIRCLE,
     };
     let budget = per_circle * (engine.len() as u64 + 1);
-    let t_end = engine.now() + dt.0;
+    let t_start = engine.now();
+    let t_end = t_start + dt.0;
     if engine.advance_to(t_end, budget).is_err() {
         engine.drift_to(t_end);
         state.budget_exhausted += 1;
     }
+    if let Some(log) = engine.drain_hits() {
+        let entity = |i: u32| state.entities[i as usize];
+        log.send_circle_hits(entity, -t_start, &mut messages.0);
+        log.send_wall_hits(entity, -t_start, &mut messages.1);
+    }
+    let (pairs, walls) = &mut counted;
     let stats = engine.stats();
     let last = std::mem::replace(&mut state.last_stats, stats);
     pairs.count += stats.pair_collisions - last.pair_collisions;
@@ -197,7 +223,7 @@ fn write_back(mut state: ResMut<EngineState>, mut circles: Circles) {
         return;
     };
     state.written.clear();
-    for (i, (_, mut p, mut v, _, _)) in circles.iter_mut().enumerate() {
+    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
         let (position, velocity) = (engine.position(i), engine.velocity(i));
         if p.0 != position {
             p.0 = position;

@@ -11,10 +11,14 @@
 //! events, keeps prediction local. A crossing changes no trajectory, so it bumps no counter
 //! (events other circles hold with the crosser stay valid). Everything is f64.
 
+mod events;
 mod predict;
 mod snapshot;
 
+pub use events::{BudgetExhausted, EventStats};
 pub use snapshot::EngineSnapshot;
+
+use events::{BestPair, Event, Kind, Motion, NO_PAIR};
 
 use bevy::math::DVec2;
 
@@ -22,87 +26,14 @@ use super::queue::EventQueue;
 use crate::arena::{Arena, minimum_image};
 use crate::boundary::reflect_off_walls;
 use crate::circle::CircleState;
-use crate::collide::contact::{apply_impulse, contact_normal};
+use crate::collide::contact::{apply_impulse, combine_restitution, contact_normal};
 use crate::grid::{CellMembers, Grid, NONE};
-
-/// Counts of what the engine did.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct EventStats {
-    /// Circle-circle collisions processed.
-    pub pair_collisions: u64,
-    /// Wall hits processed.
-    pub wall_collisions: u64,
-    /// Momentum taken up by the walls, `Σ m |Δv|`.
-    pub wall_impulse: f64,
-    /// `Σ (r_a + r_b) · j` over collisions.
-    pub virial: f64,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-enum Kind {
-    /// Nothing ahead (a resting circle alone).
-    Idle,
-    Pair,
-    Wall {
-        axis: u8,
-    },
-    Cell {
-        axis: u8,
-        up: bool,
-    },
-}
-
-/// A circle's pending event (its time lives in the queue).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-struct Event {
-    kind: Kind,
-    partner: u32,
-    partner_count: u32,
-}
-
-/// What prediction reads for each circle, kept together for the cache.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-struct Motion {
-    /// Position at time `t_at`.
-    pos: DVec2,
-    vel: DVec2,
-    t_at: f64,
-    radius: f64,
-}
-
-impl Motion {
-    #[inline]
-    fn at(&self, t: f64) -> DVec2 {
-        self.pos + self.vel * (t - self.t_at)
-    }
-}
-
-/// The soonest pair collision a circle's last look at its neighbours found.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-struct BestPair {
-    time: f64,
-    partner: u32,
-    partner_count: u32,
-}
-
-const NO_PAIR: BestPair = BestPair {
-    time: f64::INFINITY,
-    partner: NONE,
-    partner_count: 0,
-};
-
-/// Why [`EventEngine::advance_to`] stopped early.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BudgetExhausted {
-    /// Events processed before giving up.
-    pub events: u64,
-}
+use crate::hits::{ArenaWall, CircleHit, HitLog, WallHit};
 
 /// An event-driven simulation of circles.
 ///
 /// ```
 /// use bevy::math::DVec2;
-use serde::{Deserialize, Serialize};
 /// use moving_circles::arena::Arena;
 /// use moving_circles::circle::CircleState;
 /// use moving_circles::exact::engine::EventEngine;
@@ -137,6 +68,10 @@ pub struct EventEngine {
     cell_x: Vec<u32>,
     cell_y: Vec<u32>,
     stats: EventStats,
+    /// Each circle's own restitution, or empty when all take the engine's.
+    own_restitution: Vec<f64>,
+    /// Hits since the last [`EventEngine::drain_hits`], when recording.
+    hits: Option<HitLog>,
 }
 
 impl EventEngine {
@@ -189,10 +124,30 @@ impl EventEngine {
             cell_x: vec![0; n],
             cell_y: vec![0; n],
             stats: EventStats::default(),
+            own_restitution: Vec::new(),
+            hits: None,
         };
         engine.relink_all();
         engine.predict_all();
         engine
+    }
+
+    /// Gives each circle its own restitution (one value per circle, in order; empty: all take
+    /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`].
+    pub fn set_own_restitutions(&mut self, restitutions: Vec<f64>) {
+        assert!(restitutions.is_empty() || restitutions.len() == self.len());
+        self.own_restitution = restitutions;
+    }
+
+    /// Starts (or stops) recording every collision and wall hit, with its exact time, for
+    /// [`EventEngine::drain_hits`].
+    pub fn record_hits(&mut self, on: bool) {
+        self.hits = on.then(HitLog::default);
+    }
+
+    /// The hits recorded so far, in time order, if recording (the caller drains them).
+    pub fn drain_hits(&mut self) -> Option<&mut HitLog> {
+        self.hits.as_mut()
     }
 
     /// Current simulated time.
@@ -320,11 +275,26 @@ impl EventEngine {
         let (n, _) = contact_normal(self.offset(a.pos, b.pos), a.vel - b.vel);
         let (mut va, mut vb) = (a.vel, b.vel);
         let (wa, wb) = (self.inv_mass[i], self.inv_mass[j]);
-        if let Some(impulse) = apply_impulse(n, &mut va, &mut vb, wa, wb, self.restitution) {
+        let e = match self.own_restitution.as_slice() {
+            [] => self.restitution,
+            own => combine_restitution(own[i], own[j]),
+        };
+        if let Some(impulse) = apply_impulse(n, &mut va, &mut vb, wa, wb, e) {
             self.motion[i].vel = va;
             self.motion[j].vel = vb;
             self.stats.pair_collisions += 1;
             self.stats.virial += (a.radius + b.radius) * impulse;
+            if let Some(log) = &mut self.hits {
+                log.circles.push(CircleHit {
+                    a: i as u32,
+                    b: j as u32,
+                    point: a.pos + n * a.radius,
+                    normal: n,
+                    impulse,
+                    normal_speed: (a.vel - b.vel).dot(n),
+                    time: now,
+                });
+            }
         }
         self.counter[i] += 1;
         self.counter[j] += 1;
@@ -338,17 +308,41 @@ impl EventEngine {
         }
         self.advance_circle(i, self.now);
         let (min, max) = (self.arena.min, self.arena.max);
+        let e = match self.own_restitution.as_slice() {
+            [] => self.wall_restitution,
+            own => combine_restitution(own[i], self.wall_restitution),
+        };
         let m = &mut self.motion[i];
         let (lo, hi) = (min[axis] + m.radius, max[axis] - m.radius);
         let v = m.vel[axis];
         // Snap onto the wall (the event time puts it there up to rounding) and reflect.
-        m.pos[axis] = if v > 0.0 { hi } else { lo };
-        let new_v = -self.wall_restitution * v;
+        let high = v > 0.0;
+        m.pos[axis] = if high { hi } else { lo };
+        let new_v = -e * v;
         m.vel[axis] = new_v;
-        if self.inv_mass[i] > 0.0 {
-            self.stats.wall_impulse += (new_v - v).abs() / self.inv_mass[i];
+        let impulse = if self.inv_mass[i] > 0.0 {
+            (new_v - v).abs() / self.inv_mass[i]
+        } else {
+            f64::INFINITY
+        };
+        if impulse.is_finite() {
+            self.stats.wall_impulse += impulse;
         }
         self.stats.wall_collisions += 1;
+        if let Some(log) = &mut self.hits {
+            let wall = ArenaWall::on_axis(axis, high);
+            let (point, normal) = wall.contact(m.pos, &self.arena);
+            log.walls.push(WallHit {
+                circle: i as u32,
+                wall,
+                point,
+                normal,
+                impulse,
+                normal_speed: v.abs(),
+                time: self.now,
+                count: 1,
+            });
+        }
         self.counter[i] += 1;
         self.predict(i);
     }

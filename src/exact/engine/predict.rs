@@ -7,7 +7,8 @@
 
 use bevy::math::DVec2;
 
-use super::{BestPair, Event, EventEngine, Kind, NO_PAIR};
+use super::EventEngine;
+use super::events::{BestPair, Event, Kind, NO_PAIR};
 use crate::exact::toi::{pair_time_of_impact, wall_time_of_impact};
 use crate::grid::NONE;
 

@@ -6,7 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{BestPair, Event, EventEngine, EventStats, Kind, Motion};
+use super::EventEngine;
+use super::events::{BestPair, Event, EventStats, Kind, Motion};
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::exact::queue::EventQueue;
@@ -122,6 +123,8 @@ impl EventEngine {
             cell_x: s.cell_x,
             cell_y: s.cell_y,
             stats: s.stats,
+            own_restitution: Vec::new(),
+            hits: None,
         })
     }
 }

@@ -7,7 +7,6 @@
 use std::fmt;
 use std::str::FromStr;
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +14,9 @@ use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::error::FieldError;
 pub use crate::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, check_vector};
+pub use effects::Effects;
+
+mod effects;
 
 /// Most circles any input may ask for: random spawns and particle files alike. Checked before
 /// anything is allocated, so a file claiming 10¹¹ circles fails at once; and small enough that
@@ -296,68 +298,6 @@ impl<'de> Deserialize<'de> for Solver {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let s = String::deserialize(d)?;
         s.parse().map_err(serde::de::Error::custom)
-    }
-}
-
-/// The effects a scene calls for. Only these get systems in the schedule: no gravity, no
-/// gravity system; no collisions, no broad phase.
-#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[reflect(Resource, Debug)]
-#[serde(default, deny_unknown_fields)]
-pub struct Effects {
-    /// Circle-circle collisions (broad phase, separation and impulse).
-    pub collisions: bool,
-    /// Constant acceleration, e.g. `(0, -9.81)`; `None` schedules no gravity system.
-    pub gravity: Option<DVec2>,
-    /// Linear drag rate in 1/s (`v' = -drag · v`); `None` schedules no drag system.
-    pub drag: Option<f64>,
-    /// Coefficient of restitution between circles: 1 is perfectly elastic.
-    pub restitution: f64,
-    /// Coefficient of restitution against the walls.
-    pub wall_restitution: f64,
-}
-
-impl Default for Effects {
-    fn default() -> Self {
-        Self {
-            collisions: true,
-            gravity: None,
-            drag: None,
-            restitution: 1.0,
-            wall_restitution: 1.0,
-        }
-    }
-}
-
-impl Effects {
-    /// Whether every parameter is usable: restitutions in `[0, 1]`, finite gravity, a finite
-    /// non-negative drag rate.
-    pub fn check(&self) -> Result<(), FieldError> {
-        let unit = |x: f64| x.is_finite() && (0.0..=1.0).contains(&x);
-        if !unit(self.restitution) {
-            return Err(FieldError::new(
-                "effects.restitution",
-                format!("must be in [0, 1], got {}", self.restitution),
-            ));
-        }
-        if !unit(self.wall_restitution) {
-            return Err(FieldError::new(
-                "effects.wall_restitution",
-                format!("must be in [0, 1], got {}", self.wall_restitution),
-            ));
-        }
-        if let Some(g) = self.gravity {
-            check_vector("effects.gravity", g)?;
-        }
-        if let Some(drag) = self.drag
-            && !(0.0..=MAX_MAGNITUDE).contains(&drag)
-        {
-            return Err(FieldError::new(
-                "effects.drag",
-                format!("must be a rate from 0 to {MAX_MAGNITUDE:e} (1/s), got {drag}"),
-            ));
-        }
-        Ok(())
     }
 }
 

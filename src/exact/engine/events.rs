@@ -1,0 +1,80 @@
+//! The records the event engine keeps per circle (its motion, its pending event, its best pair)
+//! and the counts and errors it reports.
+
+use bevy::math::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::grid::NONE;
+
+/// Counts of what the engine did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EventStats {
+    /// Circle-circle collisions processed.
+    pub pair_collisions: u64,
+    /// Wall hits processed.
+    pub wall_collisions: u64,
+    /// Momentum taken up by the walls, `Σ m |Δv|`.
+    pub wall_impulse: f64,
+    /// `Σ (r_a + r_b) · j` over collisions.
+    pub virial: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub(super) enum Kind {
+    /// Nothing ahead (a resting circle alone).
+    Idle,
+    Pair,
+    Wall {
+        axis: u8,
+    },
+    Cell {
+        axis: u8,
+        up: bool,
+    },
+}
+
+/// A circle's pending event (its time lives in the queue).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub(super) struct Event {
+    pub(super) kind: Kind,
+    pub(super) partner: u32,
+    pub(super) partner_count: u32,
+}
+
+/// What prediction reads for each circle, kept together for the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub(super) struct Motion {
+    /// Position at time `t_at`.
+    pub(super) pos: DVec2,
+    pub(super) vel: DVec2,
+    pub(super) t_at: f64,
+    pub(super) radius: f64,
+}
+
+impl Motion {
+    #[inline]
+    pub(super) fn at(&self, t: f64) -> DVec2 {
+        self.pos + self.vel * (t - self.t_at)
+    }
+}
+
+/// The soonest pair collision a circle's last look at its neighbours found.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub(super) struct BestPair {
+    pub(super) time: f64,
+    pub(super) partner: u32,
+    pub(super) partner_count: u32,
+}
+
+pub(super) const NO_PAIR: BestPair = BestPair {
+    time: f64::INFINITY,
+    partner: NONE,
+    partner_count: 0,
+};
+
+/// Why [`EventEngine::advance_to`] stopped early.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BudgetExhausted {
+    /// Events processed before giving up.
+    pub events: u64,
+}
