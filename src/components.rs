@@ -25,7 +25,31 @@ pub struct Velocity(pub DVec2);
 #[require(Position, Velocity, Mass, Tint)]
 pub struct Radius(pub f64);
 
-/// Mass of a circle. `f64::INFINITY` makes a circle immovable (its inverse mass is zero).
+/// Mass of a circle.
+///
+/// [`Mass::IMMOVABLE`] (infinite mass) makes the other two body kinds, under every solver:
+/// - a **static** circle (an obstacle, a peg): immovable, at rest. Hits and forces never move
+///   it; circles bounce off it as off a wall.
+/// - a **kinematic** circle (a paddle): immovable, moving with the [`Velocity`] your code sets
+///   (every frame if you like). It pushes the others and nothing pushes it back; what it gave
+///   them is counted in [`PairCollisions`](crate::collide::PairCollisions)
+///   (`immovable_work`, `immovable_impulse`). Like any circle it is kept inside the walls.
+///
+/// Immovable circles carry no energy or momentum in the diagnostics, and gravity and drag
+/// leave them alone.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use bevy::prelude::*;
+/// use moving_circles::prelude::*;
+///
+/// fn place(mut commands: Commands) {
+///     // A peg, and a paddle that some other system steers by setting its velocity.
+///     commands.spawn((Radius(0.1), Position(DVec2::new(0.0, 1.0)), Mass::IMMOVABLE));
+///     commands.spawn((Radius(0.5), Position(DVec2::ZERO), Mass::IMMOVABLE, Velocity(DVec2::X)));
+/// }
+/// # bevy::ecs::system::assert_is_system(place);
+/// ```
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Default, Debug)]
 pub struct Mass(pub f64);
@@ -37,6 +61,14 @@ impl Default for Mass {
 }
 
 impl Mass {
+    /// Infinite mass: a static or kinematic circle.
+    pub const IMMOVABLE: Mass = Mass(f64::INFINITY);
+
+    /// Whether this is [`Mass::IMMOVABLE`] (any infinite mass).
+    pub fn is_immovable(self) -> bool {
+        !self.0.is_finite()
+    }
+
     /// `1 / mass`, zero for an infinite mass. Collision kernels work with inverse masses so that
     /// immovable circles need no special case.
     pub fn inverse(self) -> f64 {

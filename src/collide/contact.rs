@@ -83,6 +83,37 @@ pub fn apply_impulse(
     Some(impulse)
 }
 
+/// What one impulse gave the movable circle of a pair whose other circle is immovable (static
+/// or kinematic, inverse mass 0): the kinetic energy and momentum it gained. Zero unless
+/// exactly one of the two is immovable. `va`, `vb` are the velocities before and after.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::collide::contact::work_by_immovable;
+///
+/// // A paddle (inverse mass 0) sends a resting unit mass off at 2: it gave it 2 J and 2 N·s.
+/// let (work, impulse) =
+///     work_by_immovable((0.0, 1.0), (DVec2::X, DVec2::X), (DVec2::ZERO, 2.0 * DVec2::X));
+/// assert_eq!((work, impulse), (2.0, 2.0 * DVec2::X));
+/// ```
+#[inline]
+pub fn work_by_immovable(
+    inverse_masses: (f64, f64),
+    va: (DVec2, DVec2),
+    vb: (DVec2, DVec2),
+) -> (f64, DVec2) {
+    let (w, (before, after)) = match inverse_masses {
+        (0.0, w) if w > 0.0 => (w, vb),
+        (w, 0.0) if w > 0.0 => (w, va),
+        _ => return (0.0, DVec2::ZERO),
+    };
+    let m = 1.0 / w;
+    (
+        0.5 * m * (after.length_squared() - before.length_squared()),
+        m * (after - before),
+    )
+}
+
 /// Resolves one pair in place if it overlaps: separates it along the normal (split by inverse
 /// mass) and applies [`apply_impulse`] when the pair approaches. `b` must be the image nearest
 /// to `a` on a periodic arena.

@@ -48,6 +48,11 @@ pub struct PairCollisions {
     pub count: u64,
     /// Collisional virial `Σ (r_a + r_b) · j` over those impulses (for the pressure).
     pub virial: f64,
+    /// Kinetic energy that immovable (static or kinematic) circles gave the others: with
+    /// elastic hits, the energy a kinematic paddle injected (a static peg gives none).
+    pub immovable_work: f64,
+    /// Momentum that immovable circles gave the others.
+    pub immovable_impulse: bevy::math::DVec2,
 }
 
 /// The circles as the contact pass reads and writes them.
@@ -95,6 +100,8 @@ fn collide_circles(
     let stats = resolve_all_contacts(&mut scratch, &arena, effects.restitution, record);
     counted.count += stats.collisions;
     counted.virial += stats.virial;
+    counted.immovable_work += stats.immovable_work;
+    counted.immovable_impulse += stats.immovable_impulse;
     if effects.hit_messages {
         let (dt, start) = clock;
         log.send_circle_hits(|i| entities[i as usize], start.0 + dt.0, &mut messages);

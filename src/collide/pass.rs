@@ -8,7 +8,7 @@ use bevy::math::DVec2;
 use super::broad_phase::{
     CellList, needs_levels, overlapping_pairs, pairs_in_cell_order, radius_range,
 };
-use super::contact::{combine_restitution, resolve_contact};
+use super::contact::{combine_restitution, resolve_contact, work_by_immovable};
 use crate::arena::Arena;
 use crate::boundary::reflect_off_walls;
 use crate::circle::CircleState;
@@ -76,6 +76,10 @@ pub struct PassStats {
     pub contacts: u64,
     /// `Σ (r_a + r_b) · j` over collisions: the collisional virial.
     pub virial: f64,
+    /// Kinetic energy immovable circles gave movable ones ([`work_by_immovable`]).
+    pub immovable_work: f64,
+    /// Momentum immovable circles gave movable ones.
+    pub immovable_impulse: DVec2,
 }
 
 /// Finds and resolves all overlapping pairs among the circles in `scratch`, in the broad
@@ -134,6 +138,7 @@ pub fn resolve_all_contacts(
         } else {
             combine_restitution(restitutions[i], restitutions[j])
         };
+        let (va, vb) = (a.velocity, b.velocity);
         let outcome = resolve_contact(&mut a, &mut b, e);
         (sorted[k].0, velocities[i]) = (a.position, a.velocity);
         (sorted[l].0, velocities[j]) = (b.position + shift, b.velocity);
@@ -141,6 +146,13 @@ pub fn resolve_all_contacts(
         if outcome.impulse > 0.0 {
             stats.collisions += 1;
             stats.virial += (a.radius + b.radius) * outcome.impulse;
+            let inverse = (a.inv_mass(), b.inv_mass());
+            if inverse.0 == 0.0 || inverse.1 == 0.0 {
+                let (work, impulse) =
+                    work_by_immovable(inverse, (va, a.velocity), (vb, b.velocity));
+                stats.immovable_work += work;
+                stats.immovable_impulse += impulse;
+            }
             if let Some(log) = hits.as_deref_mut() {
                 log.circles.push(CircleHit {
                     a: i as u32,

@@ -31,6 +31,10 @@ use engine::{EngineSnapshot, EventEngine, EventStats};
 pub const SWEPT_EVENTS_PER_CIRCLE: u64 = 64;
 /// The same bound for `exact`, high enough to be reached only by inelastic collapse.
 pub const EXACT_EVENTS_PER_CIRCLE: u64 = 100_000;
+/// `exact` updates its engine in place when at most one circle in this many was moved from
+/// outside since the last step, and rebuilds it when more were (each update costs about what a
+/// collision does; a rebuild, what `N` of them do).
+const MOVED_FOR_REBUILD: usize = 4;
 
 /// Adds the `swept` / `exact` step to [`ContinuousStep`].
 #[derive(Clone, Copy, Debug, Default)]
@@ -61,12 +65,16 @@ pub struct EngineState {
     written: Vec<(DVec2, DVec2)>,
     /// The circles' own restitutions the engine was built with (empty if none had one).
     own_restitution: Vec<f64>,
+    /// `(radius, mass)` of each circle the engine was built with.
+    shapes: Vec<(f64, f64)>,
     setup: Option<(Arena, Effects, Solver)>,
     last_stats: EventStats,
     /// Steps whose event budget ran out (their remainder was free flight).
     pub budget_exhausted: u64,
     /// Times the engine was rebuilt from the ECS state.
     pub rebuilds: u64,
+    /// Steps in which the kept engine was updated for a few circles moved from outside.
+    pub updates: u64,
 }
 
 impl EngineState {
@@ -106,6 +114,7 @@ impl EngineState {
         self.last_stats = engine.stats();
         self.engine = Some(engine);
         self.entities = circles.iter().map(|&(e, _)| e).collect();
+        self.shapes = states.iter().map(|c| (c.radius, c.mass)).collect();
         self.written = states.iter().map(|c| (c.position, c.velocity)).collect();
         self.setup = Some((arena, effects, Solver::Exact));
         Ok(())
@@ -128,7 +137,9 @@ type Circles<'w, 's> = Query<
 >;
 
 /// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
-/// step; otherwise (and always for `swept`) builds a fresh one from the circles.
+/// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
+/// paddle); otherwise (and always for `swept`) builds a fresh one from the circles. Says which
+/// in a debug log.
 fn gather_into_engine(
     solver: Res<Solver>,
     arena: Res<Arena>,
@@ -145,17 +156,52 @@ fn gather_into_engine(
         let scene = effects.restitution;
         circles.iter().map(|c| c.5.map_or(scene, |e| e.0)).collect()
     };
-    let unchanged = *solver == Solver::Exact
-        && state.engine.is_some()
-        && state.setup == Some(setup)
-        && state.own_restitution == own
-        && circles.iter().len() == state.entities.len()
-        && circles
+    let rebuild = if *solver != Solver::Exact {
+        Some("swept builds every step")
+    } else if state.engine.is_none() || state.setup != Some(setup) {
+        Some("new solver, arena or effects")
+    } else if circles.iter().len() != state.entities.len()
+        || circles.iter().zip(&state.entities).any(|(c, &e)| c.0 != e)
+    {
+        Some("circles were spawned or despawned")
+    } else if state.own_restitution != own
+        || circles
             .iter()
-            .zip(state.entities.iter().zip(&state.written))
-            .all(|((e, p, v, ..), (&we, &(wp, wv)))| e == we && p.0 == wp && v.0 == wv);
-    if unchanged {
-        return;
+            .zip(&state.shapes)
+            .any(|(c, &shape)| (c.3.0, c.4.0) != shape)
+    {
+        Some("a radius, mass or restitution changed")
+    } else {
+        let moved: Vec<(usize, DVec2, DVec2)> = circles
+            .iter()
+            .zip(&state.written)
+            .enumerate()
+            .filter_map(|(i, (c, written))| {
+                let now = (c.1.0, c.2.0);
+                (now != *written).then_some((i, now.0, now.1))
+            })
+            .collect();
+        if moved.is_empty() {
+            return;
+        }
+        if moved.len() <= circles.iter().len() / MOVED_FOR_REBUILD {
+            let engine = state.engine.as_mut().expect("checked above");
+            for &(i, position, velocity) in &moved {
+                engine.set_motion(i, position, velocity);
+            }
+            debug!(
+                "exact engine: updated {} circle(s) moved from outside",
+                moved.len()
+            );
+            state.updates += 1;
+            return;
+        }
+        Some("most circles were changed from outside (a force effect, a respawn)")
+    };
+    if *solver == Solver::Exact
+        && let Some(reason) = rebuild
+    {
+        debug!("exact engine: rebuilt ({reason})");
     }
     let bodies: Vec<CircleState> = circles
         .iter()
@@ -170,6 +216,7 @@ fn gather_into_engine(
     engine.set_own_restitutions(own.clone());
     engine.record_hits(effects.hit_messages);
     state.own_restitution = own;
+    state.shapes = bodies.iter().map(|c| (c.radius, c.mass)).collect();
     state.last_stats = engine.stats();
     state.engine = Some(engine);
     state.entities = circles.iter().map(|(e, ..)| e).collect();
@@ -211,6 +258,8 @@ fn advance_engine(
     let last = std::mem::replace(&mut state.last_stats, stats);
     pairs.count += stats.pair_collisions - last.pair_collisions;
     pairs.virial += stats.virial - last.virial;
+    pairs.immovable_work += stats.immovable_work - last.immovable_work;
+    pairs.immovable_impulse += stats.immovable_impulse - last.immovable_impulse;
     walls.count += stats.wall_collisions - last.wall_collisions;
     walls.impulse += stats.wall_impulse - last.wall_impulse;
 }

@@ -17,6 +17,10 @@ pub struct EventStats {
     pub wall_impulse: f64,
     /// `Σ (r_a + r_b) · j` over collisions.
     pub virial: f64,
+    /// Kinetic energy immovable circles gave movable ones.
+    pub immovable_work: f64,
+    /// Momentum immovable circles gave movable ones.
+    pub immovable_impulse: DVec2,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -26,7 +26,9 @@ use super::queue::EventQueue;
 use crate::arena::{Arena, minimum_image};
 use crate::boundary::reflect_off_walls;
 use crate::circle::CircleState;
-use crate::collide::contact::{apply_impulse, combine_restitution, contact_normal};
+use crate::collide::contact::{
+    apply_impulse, combine_restitution, contact_normal, work_by_immovable,
+};
 use crate::grid::{CellMembers, Grid, NONE};
 use crate::hits::{ArenaWall, CircleHit, HitLog, WallHit};
 
@@ -148,6 +150,26 @@ impl EventEngine {
     /// The hits recorded so far, in time order, if recording (the caller drains them).
     pub fn drain_hits(&mut self) -> Option<&mut HitLog> {
         self.hits.as_mut()
+    }
+
+    /// Puts circle `i` at `position` with `velocity` now (something outside the engine moved
+    /// it: a teleport, a kinematic circle steered by user code) and predicts it again. Events
+    /// other circles hold with it become stale, as after a collision.
+    pub fn set_motion(&mut self, i: usize, position: DVec2, velocity: DVec2) {
+        let position = if self.arena.is_periodic() {
+            self.arena.wrap(position)
+        } else {
+            position
+        };
+        self.motion[i].pos = position;
+        self.motion[i].vel = velocity;
+        self.motion[i].t_at = self.now;
+        self.counter[i] += 1;
+        self.cells.remove(i, self.cell_index(i));
+        let (x, y) = self.grid.cell_of(position);
+        (self.cell_x[i], self.cell_y[i]) = (x as u32, y as u32);
+        self.cells.insert(i, self.grid.index(x, y));
+        self.predict(i);
     }
 
     /// Current simulated time.
@@ -284,6 +306,11 @@ impl EventEngine {
             self.motion[j].vel = vb;
             self.stats.pair_collisions += 1;
             self.stats.virial += (a.radius + b.radius) * impulse;
+            if wa == 0.0 || wb == 0.0 {
+                let (work, gained) = work_by_immovable((wa, wb), (a.vel, va), (b.vel, vb));
+                self.stats.immovable_work += work;
+                self.stats.immovable_impulse += gained;
+            }
             if let Some(log) = &mut self.hits {
                 log.circles.push(CircleHit {
                     a: i as u32,
