@@ -251,3 +251,39 @@ fn circles_come_and_go_between_steps_under_every_solver() {
         );
     }
 }
+
+#[test]
+fn a_scene_declares_static_pegs_and_refuses_moving_or_weighed_ones() {
+    for solver in SOLVERS {
+        let mut app = scene_app(&format!(
+            "(solver: \"{solver}\", arena: (size: (6.0, 6.0), boundary: walls),
+              effects: (gravity: (0.0, -4.0), restitution: 0.7),
+              circles: [(position: (0.0, 0.0), radius: 0.4, immovable: true),
+                        (position: (0.1, 2.0), radius: 0.2)])"
+        ));
+        step(&mut app, 120);
+        let all = circles(&mut app);
+        assert_eq!(
+            (all[0].0, all[0].1, all[0].3),
+            (DVec2::ZERO, DVec2::ZERO, f64::INFINITY)
+        );
+        assert!(
+            all[1].0.distance(DVec2::ZERO) >= 0.6 - 1e-6,
+            "{solver}: {:?}",
+            all[1]
+        );
+        assert!(pair_collisions(&app) > 0, "{solver}");
+    }
+    for (extra, field) in [
+        ("mass: 2.0", "circles[0].mass"),
+        ("velocity: (1.0, 0.0)", "circles[0].velocity"),
+    ] {
+        let text =
+            format!("(circles: [(position: (0.0, 0.0), radius: 0.4, immovable: true, {extra})])");
+        let err = Scene::parse(&text, "pegs.ron")
+            .and_then(|s| s.to_config("pegs.ron"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(&format!("pegs.ron: field `{field}`")), "{err}");
+    }
+}

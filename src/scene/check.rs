@@ -79,15 +79,32 @@ impl Scene {
         };
         config.check().map_err(field_error)?;
         for (i, spec) in self.circles.iter().enumerate() {
+            let within = |e: FieldError| field_error(e.within(&format!("circles[{i}]")));
+            if spec.immovable && spec.mass.is_some() {
+                let why = "an immovable circle's mass is infinite; give no `mass`";
+                return Err(within(FieldError::new("mass", why)));
+            }
+            if let Some(m) = spec.mass {
+                check_mass("mass", m).map_err(|e| {
+                    within(FieldError::new(
+                        "mass",
+                        format!("{} (a static circle: `immovable: true`)", e.message),
+                    ))
+                })?;
+            }
+            let mass = if spec.immovable {
+                f64::INFINITY
+            } else {
+                spec.mass.unwrap_or_else(|| self.mass.mass_of(spec.radius))
+            };
             let circle = CircleState {
                 position: spec.position,
                 velocity: spec.velocity,
                 radius: spec.radius,
-                mass: spec.mass.unwrap_or_else(|| self.mass.mass_of(spec.radius)),
+                mass,
                 tint: spec.color.unwrap_or(Tint::default().0),
             };
-            check_circle(&circle, &arena)
-                .map_err(|e| field_error(e.within(&format!("circles[{i}]"))))?;
+            check_circle(&circle, &arena).map_err(within)?;
             config.circles.push(circle);
         }
         if self.separate_overlaps {
@@ -106,18 +123,28 @@ impl Scene {
     }
 }
 
-/// Checks one explicit circle: finite, positive radius and mass, inside the arena (entirely,
-/// with walls; its centre, when periodic), not larger than it.
+/// Checks one explicit circle: finite, positive radius, a mass in range or infinite (a static
+/// circle, which must be at rest), inside the arena (entirely, with walls; its centre, when
+/// periodic), not larger than it.
 pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
     check_vector("position", c.position)?;
     check_vector("velocity", c.velocity)?;
+    if c.mass == f64::INFINITY && c.velocity != DVec2::ZERO {
+        return Err(FieldError::new(
+            "velocity",
+            "an immovable (infinite-mass) circle in a file is static: it must be at rest \
+             (kinematic circles are steered by code)",
+        ));
+    }
     if !(c.radius.is_finite() && c.radius > 0.0) {
         return Err(FieldError::new(
             "radius",
             format!("must be positive and finite, got {}", c.radius),
         ));
     }
-    check_mass("mass", c.mass)?;
+    if c.mass != f64::INFINITY {
+        check_mass("mass", c.mass)?;
+    }
     if c.radius < min_radius(arena) {
         return Err(FieldError::new(
             "radius",

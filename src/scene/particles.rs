@@ -1,7 +1,8 @@
 //! The plain-text particle format of the Princeton event-driven collision demo: first line `N`,
 //! then one line per circle `rx ry vx vy radius mass r g b` (colour bytes 0-255), in the unit
 //! square `[0, 1]²`. Read exactly — every problem names its line — and written back exactly
-//! (shortest round-trip decimal for each number).
+//! (shortest round-trip decimal for each number). A mass of `inf` is a static circle (it must
+//! then be at rest).
 
 use std::io::BufRead;
 use std::path::Path;

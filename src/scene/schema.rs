@@ -49,6 +49,11 @@ pub struct CircleSpec {
     /// Colour as sRGB bytes; by default light grey.
     #[serde(default)]
     pub color: Option<[u8; 3]>,
+    /// A static obstacle (a peg): infinite mass ([`Mass::IMMOVABLE`](crate::components::Mass)),
+    /// at rest for good. Gives no `mass` and no `velocity` (a moving immovable circle is a
+    /// kinematic one, which code steers).
+    #[serde(default)]
+    pub immovable: bool,
 }
 
 /// A scene file. Every field has a default, so a file names only what it changes.
