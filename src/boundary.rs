@@ -14,7 +14,7 @@ use bevy::prelude::*;
 
 use crate::arena::Arena;
 use crate::collide::contact::combine_restitution;
-use crate::components::{Mass, Position, Radius, Restitution, Velocity};
+use crate::components::{Position, SolverCircles};
 use crate::config::Effects;
 use crate::effects::{Effect, register_effect};
 use crate::hits::{ArenaWall, HitLog, WallHit};
@@ -160,20 +160,6 @@ fn reflect_axis(p: &mut f64, v: &mut f64, lo: f64, hi: f64) -> u64 {
     crossings.max(1)
 }
 
-/// The circles as the wall bounce reads and writes them.
-type Circles<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Entity,
-        &'static mut Position,
-        &'static mut Velocity,
-        &'static Radius,
-        &'static Mass,
-        Option<&'static Restitution>,
-    ),
->;
-
 /// Applies [`reflect_off_walls`] to every circle (with its own restitution combined with the
 /// walls', if it has one), counts the hits and adds the momentum the walls took up
 /// (`Σ m |Δv|`, for the wall pressure); with `effects.hit_messages`, writes a [`WallHit`] per
@@ -185,7 +171,7 @@ fn bounce_off_walls(
     mut walls: ResMut<WallCollisions>,
     mut log: Local<(HitLog, Vec<Entity>)>,
     mut messages: MessageWriter<WallHit>,
-    mut circles: Circles,
+    mut circles: SolverCircles,
 ) {
     let (log, entities) = &mut *log;
     let mut hits = 0u64;

@@ -99,6 +99,21 @@ impl Default for Tint {
     }
 }
 
+/// The circles as every solver's systems read and write them (the discrete contact pass, the
+/// wall bounce, the continuous step), in one query type so each sees them in the same order.
+pub type SolverCircles<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static mut Position,
+        &'static mut Velocity,
+        &'static Radius,
+        &'static Mass,
+        Option<&'static Restitution>,
+    ),
+>;
+
 impl From<DVec2> for Position {
     fn from(v: DVec2) -> Self {
         Self(v)

@@ -14,7 +14,7 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
-use crate::components::{Mass, Position, Radius, Restitution, Velocity};
+use crate::components::{Restitution, SolverCircles};
 use crate::config::Effects;
 use crate::effects::{Effect, register_effect};
 use crate::hits::{CircleHit, HitLog};
@@ -55,20 +55,6 @@ pub struct PairCollisions {
     pub immovable_impulse: bevy::math::DVec2,
 }
 
-/// The circles as the contact pass reads and writes them.
-type Circles<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Entity,
-        &'static mut Position,
-        &'static mut Velocity,
-        &'static Radius,
-        &'static Mass,
-        Option<&'static Restitution>,
-    ),
->;
-
 /// Gathers the circles, resolves their contacts with [`resolve_all_contacts`] and writes back
 /// what changed; with `effects.hit_messages`, writes a [`CircleHit`] per collision.
 #[allow(clippy::too_many_arguments)]
@@ -81,7 +67,7 @@ fn collide_circles(
     mut log: Local<(HitLog, Vec<Entity>)>,
     mut messages: MessageWriter<CircleHit>,
     own_restitution: Query<(), With<Restitution>>,
-    mut circles: Circles,
+    mut circles: SolverCircles,
 ) {
     scratch.clear();
     let (log, entities) = &mut *log;

@@ -21,7 +21,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::CircleState;
 use crate::collide::PairCollisions;
-use crate::components::{Mass, Position, Radius, Restitution, Velocity};
+use crate::components::{Restitution, SolverCircles};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
@@ -121,21 +121,6 @@ impl EngineState {
     }
 }
 
-/// The circles as the continuous step reads and writes them, in one query type so that every
-/// system of the step sees them in the same order.
-type Circles<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Entity,
-        &'static mut Position,
-        &'static mut Velocity,
-        &'static Radius,
-        &'static Mass,
-        Option<&'static Restitution>,
-    ),
->;
-
 /// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
 /// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
 /// paddle); otherwise (and always for `swept`) builds a fresh one from the circles. Says which
@@ -146,7 +131,7 @@ fn gather_into_engine(
     effects: Res<Effects>,
     mut state: ResMut<EngineState>,
     own_restitution: Query<(), With<Restitution>>,
-    circles: Circles,
+    circles: SolverCircles,
 ) {
     let state = &mut *state;
     let setup = (*arena, *effects, *solver);
@@ -266,7 +251,7 @@ fn advance_engine(
 
 /// Writes the engine's positions and velocities back to the circles that changed, and
 /// remembers what it wrote.
-fn write_back(mut state: ResMut<EngineState>, mut circles: Circles) {
+fn write_back(mut state: ResMut<EngineState>, mut circles: SolverCircles) {
     let state = &mut *state;
     let Some(engine) = state.engine.as_ref() else {
         return;
