@@ -159,3 +159,20 @@ fn a_circle_restitution_combines_with_the_scene_as_the_minimum() {
         }
     }
 }
+
+#[test]
+fn a_restitution_given_in_flight_takes_effect_at_the_next_hit() {
+    for solver in SOLVERS {
+        let mut app = scene_app(&format!(
+            "(solver: \"{solver}\", arena: (size: (4.0, 4.0), boundary: walls),
+              effects: (wall_restitution: 1.0), spawn: (count: 0))"
+        ));
+        // Rising at 1 from the centre: it meets the top wall (y = 1.75) after 1.75 s.
+        let c = spawn_circle(&mut app, DVec2::ZERO, DVec2::Y, 0.25, 1.0);
+        step(&mut app, 10);
+        app.world_mut().entity_mut(c).insert(Restitution(0.5));
+        step(&mut app, 110);
+        let v = state(&app, c).1;
+        assert!((v.y + 0.5).abs() < 1e-9, "{solver}: {v}");
+    }
+}

@@ -63,10 +63,6 @@ pub struct EngineState {
     engine: Option<EventEngine>,
     entities: Vec<Entity>,
     written: Vec<(DVec2, DVec2)>,
-    /// The circles' own restitutions the engine was built with (empty if none had one).
-    own_restitution: Vec<f64>,
-    /// `(radius, mass)` of each circle the engine was built with.
-    shapes: Vec<(f64, f64)>,
     setup: Option<(Arena, Effects, Solver)>,
     last_stats: EventStats,
     /// Steps whose event budget ran out (their remainder was free flight).
@@ -114,7 +110,6 @@ impl EngineState {
         self.last_stats = engine.stats();
         self.engine = Some(engine);
         self.entities = circles.iter().map(|&(e, _)| e).collect();
-        self.shapes = states.iter().map(|c| (c.radius, c.mass)).collect();
         self.written = states.iter().map(|c| (c.position, c.velocity)).collect();
         self.setup = Some((arena, effects, Solver::Exact));
         Ok(())
@@ -135,57 +130,29 @@ fn gather_into_engine(
 ) {
     let state = &mut *state;
     let setup = (*arena, *effects, *solver);
-    let own: Vec<f64> = if own_restitution.is_empty() {
-        Vec::new()
-    } else {
-        let scene = effects.restitution;
-        circles.iter().map(|c| c.5.map_or(scene, |e| e.0)).collect()
-    };
-    let rebuild = if *solver != Solver::Exact {
-        Some("swept builds every step")
-    } else if state.engine.is_none() || state.setup != Some(setup) {
-        Some("new solver, arena or effects")
-    } else if circles.iter().len() != state.entities.len()
-        || circles.iter().zip(&state.entities).any(|(c, &e)| c.0 != e)
-    {
-        Some("circles were spawned or despawned")
-    } else if state.own_restitution != own
-        || circles
-            .iter()
-            .zip(&state.shapes)
-            .any(|(c, &shape)| (c.3.0, c.4.0) != shape)
-    {
-        Some("a radius, mass or restitution changed")
-    } else {
-        let moved: Vec<(usize, DVec2, DVec2)> = circles
-            .iter()
-            .zip(&state.written)
-            .enumerate()
-            .filter_map(|(i, (c, written))| {
-                let now = (c.1.0, c.2.0);
-                (now != *written).then_some((i, now.0, now.1))
-            })
-            .collect();
-        if moved.is_empty() {
-            return;
-        }
-        if moved.len() <= circles.iter().len() / MOVED_FOR_REBUILD {
-            let engine = state.engine.as_mut().expect("checked above");
-            for &(i, position, velocity) in &moved {
-                engine.set_motion(i, position, velocity);
+    let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
+    let reason = match (&mut state.engine, *solver) {
+        (Some(engine), Solver::Exact) if state.setup == Some(setup) => {
+            let known = (state.entities.as_slice(), state.written.as_slice());
+            match moved_since(engine, known, &circles, restitution_of) {
+                Ok(moved) if moved.is_empty() => return,
+                Ok(moved) if moved.len() <= circles.iter().len() / MOVED_FOR_REBUILD => {
+                    for &(i, position, velocity) in &moved {
+                        engine.set_motion(i, position, velocity);
+                    }
+                    let n = moved.len();
+                    debug!("exact engine: updated {n} circle(s) moved from outside");
+                    state.updates += 1;
+                    return;
+                }
+                Ok(_) => "most circles were changed from outside (a force effect)",
+                Err(reason) => reason,
             }
-            debug!(
-                "exact engine: updated {} circle(s) moved from outside",
-                moved.len()
-            );
-            state.updates += 1;
-            return;
         }
-        Some("most circles were changed from outside (a force effect, a respawn)")
+        (_, Solver::Exact) => "new solver, arena or effects",
+        _ => "swept builds every step",
     };
-    if *solver == Solver::Exact
-        && let Some(reason) = rebuild
-    {
+    if *solver == Solver::Exact {
         debug!("exact engine: rebuilt ({reason})");
     }
     let bodies: Vec<CircleState> = circles
@@ -198,15 +165,44 @@ fn gather_into_engine(
         effects.restitution,
         effects.wall_restitution,
     );
-    engine.set_own_restitutions(own.clone());
+    if !own_restitution.is_empty() {
+        engine.set_own_restitutions(circles.iter().map(|c| restitution_of(c.5)).collect());
+    }
     engine.record_hits(effects.hit_messages);
-    state.own_restitution = own;
-    state.shapes = bodies.iter().map(|c| (c.radius, c.mass)).collect();
     state.last_stats = engine.stats();
     state.engine = Some(engine);
     state.entities = circles.iter().map(|(e, ..)| e).collect();
     state.setup = Some(setup);
     state.rebuilds += 1;
+}
+
+/// The circles user code moved or steered since the kept `engine` last wrote them (index, new
+/// position and velocity), in one pass over `circles` against the `known` entities and what was
+/// written to them; or why the engine cannot be kept (a circle came, went, or changed its
+/// radius, mass or restitution).
+fn moved_since(
+    engine: &EventEngine,
+    known: (&[Entity], &[(DVec2, DVec2)]),
+    circles: &SolverCircles,
+    restitution_of: impl Fn(Option<&Restitution>) -> f64,
+) -> Result<Vec<(usize, DVec2, DVec2)>, &'static str> {
+    let (entities, written) = known;
+    if circles.iter().len() != entities.len() {
+        return Err("circles were spawned or despawned");
+    }
+    let mut moved = Vec::new();
+    for (i, (c, (&entity, &was))) in circles.iter().zip(entities.iter().zip(written)).enumerate() {
+        if c.0 != entity {
+            return Err("circles were spawned or despawned");
+        }
+        if engine.body(i) != (c.3.0, c.4.inverse(), restitution_of(c.5)) {
+            return Err("a radius, mass or restitution changed");
+        }
+        if (c.1.0, c.2.0) != was {
+            moved.push((i, c.1.0, c.2.0));
+        }
+    }
+    Ok(moved)
 }
 
 /// Processes the step's events (within the solver's budget), counts what they did and, when

@@ -80,22 +80,22 @@ impl Scene {
         config.check().map_err(field_error)?;
         for (i, spec) in self.circles.iter().enumerate() {
             let within = |e: FieldError| field_error(e.within(&format!("circles[{i}]")));
-            if spec.immovable && spec.mass.is_some() {
-                let why = "an immovable circle's mass is infinite; give no `mass`";
-                return Err(within(FieldError::new("mass", why)));
-            }
-            if let Some(m) = spec.mass {
-                check_mass("mass", m).map_err(|e| {
-                    within(FieldError::new(
-                        "mass",
-                        format!("{} (a static circle: `immovable: true`)", e.message),
-                    ))
-                })?;
-            }
-            let mass = if spec.immovable {
-                f64::INFINITY
-            } else {
-                spec.mass.unwrap_or_else(|| self.mass.mass_of(spec.radius))
+            let mass = match (spec.immovable, spec.mass) {
+                (true, None) => f64::INFINITY,
+                (true, Some(_)) => {
+                    let why = "an immovable circle's mass is infinite; give no `mass`";
+                    return Err(within(FieldError::new("mass", why)));
+                }
+                // check_circle takes an infinite mass as a static circle; a scene says so in
+                // words.
+                (false, Some(m)) => match check_mass("mass", m) {
+                    Err(range) if m.is_infinite() => {
+                        let why = format!("{} (a static circle: `immovable: true`)", range.message);
+                        return Err(within(FieldError::new("mass", why)));
+                    }
+                    _ => m,
+                },
+                (false, None) => self.mass.mass_of(spec.radius),
             };
             let circle = CircleState {
                 position: spec.position,

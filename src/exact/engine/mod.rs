@@ -202,6 +202,17 @@ impl EventEngine {
         self.motion[i].vel
     }
 
+    /// What circle `i` was built with: radius, inverse mass and the restitution it bounces
+    /// off other circles with (its own, or the engine's).
+    pub fn body(&self, i: usize) -> (f64, f64, f64) {
+        let restitution = self.own_restitution.get(i).copied();
+        (
+            self.motion[i].radius,
+            self.inv_mass[i],
+            restitution.unwrap_or(self.restitution),
+        )
+    }
+
     /// Processes every event up to time `t_end` and moves the clock there. Stops early (with the
     /// clock at the last processed event) after `max_events` events.
     pub fn advance_to(&mut self, t_end: f64, max_events: u64) -> Result<u64, BudgetExhausted> {
