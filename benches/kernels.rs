@@ -26,7 +26,7 @@ fn sizes() -> Vec<usize> {
 /// The placed circles of [`common::gas`] and its arena.
 fn gas(n: usize) -> (Arena, Vec<CircleState>) {
     let config = common::gas(n, Solver::Discrete);
-    let circles = place_circles(&config.arena, &config.spawn, &[]).expect("valid");
+    let circles = place_circles(&config.arena, &config.spawn, &[], &[]).expect("valid");
     (config.arena, circles)
 }
 
@@ -91,7 +91,7 @@ fn exact_events(c: &mut Criterion) {
     group.sample_size(10);
     for n in [1_000, 10_000] {
         let (arena, circles) = gas(n);
-        let mut engine = EventEngine::new(&circles, &arena, 1.0, 1.0);
+        let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         // Each iteration processes exactly this many valid events (collisions, wall hits and
         // cell crossings), so throughput is events per second.
         let batch = 10_000u64;

@@ -32,6 +32,7 @@ fn main() -> AppExit {
     let spawner = SpawnPlugin {
         config: spawn,
         circles: vec![heavy],
+        drop: None,
     };
     App::new()
         .add_plugins(MinimalPlugins.set(ScheduleRunnerPlugin::run_loop(Duration::ZERO)))

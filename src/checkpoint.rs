@@ -14,7 +14,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
-use crate::config::{CirclesConfig, Effects, MAX_CIRCLES, Solver, SpawnConfig};
+use crate::config::{CirclesConfig, DropConfig, Effects, MAX_CIRCLES, Solver, SpawnConfig};
 use crate::error::InputError;
 use crate::exact::EngineState;
 use crate::exact::engine::EngineSnapshot;
@@ -22,10 +22,11 @@ use crate::io::read_bytes_limited;
 use crate::range::{check_mass, check_vector};
 use crate::run::{Progress, headless_app};
 use crate::schedule::StepTotals;
-use crate::spawn::SpawnReport;
+use crate::segment::Segments;
+use crate::spawn::{Dropped, SpawnReport};
 
 /// The first field of every checkpoint: what it is and the layout's version.
-const FORMAT: &str = "moving_circles checkpoint 2";
+const FORMAT: &str = "moving_circles checkpoint 3";
 /// Most bytes a checkpoint may have: the most circles an input may ask for, each with its
 /// engine state, fit.
 pub const MAX_CHECKPOINT_BYTES: u64 = 2 << 30;
@@ -40,6 +41,9 @@ pub struct Checkpoint {
     solver: Solver,
     effects: Effects,
     dt: f64,
+    segments: Segments,
+    drop: Option<DropConfig>,
+    dropped: usize,
     requested: usize,
     circles: Vec<CircleState>,
     steps: StepTotals,
@@ -62,6 +66,9 @@ impl Checkpoint {
             solver: *world.resource::<Solver>(),
             effects: *world.resource::<Effects>(),
             dt: world.resource::<Time<Fixed>>().timestep().as_secs_f64(),
+            segments: world.resource::<Segments>().clone(),
+            drop: world.get_resource::<DropConfig>().copied(),
+            dropped: world.resource::<Dropped>().count,
             requested: world.resource::<SpawnReport>().requested,
             circles: snapshot(world),
             steps: *world.resource::<StepTotals>(),
@@ -176,6 +183,8 @@ impl Checkpoint {
             effects: self.effects,
             dt: self.dt,
             circles: self.circles.clone(),
+            segments: self.segments.clone(),
+            drop: self.drop,
         }
     }
 
@@ -188,6 +197,11 @@ impl Checkpoint {
         world.insert_resource(self.pairs);
         world.insert_resource(self.walls);
         world.resource_mut::<SpawnReport>().requested = self.requested;
+        let generation = world.resource::<SpawnReport>().generation;
+        world.insert_resource(Dropped {
+            count: self.dropped,
+            generation,
+        });
         let circles = snapshot_with_entities(world);
         if circles.iter().map(|(_, c)| c).ne(self.circles.iter()) {
             return Err(InputError::whole(
@@ -199,7 +213,7 @@ impl Checkpoint {
         state.budget_exhausted = self.budget_exhausted;
         if let Some(engine) = self.engine {
             state
-                .restore(engine, &circles, (self.arena, self.effects))
+                .restore(engine, &circles, (self.arena, self.effects, &self.segments))
                 .map_err(|message| InputError::whole(origin, message))?;
         }
         Ok((app, self.progress))

@@ -1,7 +1,7 @@
 //! The effects a scene can call for, and the registry that keeps exactly those in the schedule.
 //!
-//! Each effect's plugin (gravity and drag in `forces`, walls and periodic edges in `boundary`,
-//! collisions in `collide`) owns its systems and hands a recipe for them to
+//! Each effect's plugin (gravity and drag in `forces`, walls, segment walls and periodic edges in
+//! `boundary`, collisions in `collide`) owns its systems and hands a recipe for them to
 //! [`register_effect`]. The recipe is used at once if the configuration calls for the effect,
 //! and again by [`reconcile_effects`] when a reloaded scene switches the effect on; switching it
 //! off removes its systems. This module names no system, so it imports none.
@@ -14,6 +14,7 @@ use bevy::prelude::*;
 
 use crate::arena::{Arena, Boundary};
 use crate::config::Effects;
+use crate::segment::Segments;
 
 /// One schedulable effect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -22,6 +23,8 @@ pub enum Effect {
     Gravity,
     /// Linear drag.
     Drag,
+    /// Segment walls inside the arena.
+    Segments,
     /// Solid walls.
     Walls,
     /// Periodic edges.
@@ -36,37 +39,42 @@ pub struct EffectSystems(pub Effect);
 
 impl Effect {
     /// Every effect, in schedule order.
-    pub const ALL: [Effect; 5] = [
+    pub const ALL: [Effect; 6] = [
         Effect::Gravity,
         Effect::Drag,
+        Effect::Segments,
         Effect::Walls,
         Effect::Periodic,
         Effect::Collisions,
     ];
 
-    /// Whether `effects` on an arena with this `boundary` calls for this effect.
-    pub fn is_called_for(self, effects: &Effects, boundary: Boundary) -> bool {
+    /// Whether `effects` on an arena with this `boundary` and these `segments` calls for this
+    /// effect (segment walls need an arena with walls).
+    pub fn is_called_for(self, effects: &Effects, boundary: Boundary, segments: &Segments) -> bool {
         match self {
             Effect::Gravity => effects.gravity.is_some(),
             Effect::Drag => effects.drag.is_some(),
+            Effect::Segments => boundary == Boundary::Walls && !segments.is_empty(),
             Effect::Walls => boundary == Boundary::Walls,
             Effect::Periodic => boundary == Boundary::Periodic,
             Effect::Collisions => effects.collisions,
         }
     }
 
-    /// The effects `effects` on an arena with this `boundary` calls for, in schedule order.
+    /// The effects `effects` on an arena with this `boundary` and these `segments` calls for,
+    /// in schedule order.
     ///
     /// ```
     /// use moving_circles::prelude::*;
     ///
     /// let effects = Effects { collisions: false, ..Effects::default() };
-    /// assert_eq!(Effect::called_for(&effects, Boundary::Walls), [Effect::Walls]);
+    /// let none = Segments::default();
+    /// assert_eq!(Effect::called_for(&effects, Boundary::Walls, &none), [Effect::Walls]);
     /// ```
-    pub fn called_for(effects: &Effects, boundary: Boundary) -> Vec<Effect> {
+    pub fn called_for(effects: &Effects, boundary: Boundary, segments: &Segments) -> Vec<Effect> {
         Self::ALL
             .into_iter()
-            .filter(|e| e.is_called_for(effects, boundary))
+            .filter(|e| e.is_called_for(effects, boundary, segments))
             .collect()
     }
 
@@ -75,6 +83,7 @@ impl Effect {
         match self {
             Effect::Gravity => "gravity",
             Effect::Drag => "drag",
+            Effect::Segments => "segments",
             Effect::Walls => "walls",
             Effect::Periodic => "periodic",
             Effect::Collisions => "collisions",
@@ -113,7 +122,8 @@ impl EffectRegistry {
 }
 
 /// Registers `effect`'s systems, made by `systems`, for `schedules`; adds them now if the app's
-/// [`Effects`] and [`Arena`] call for the effect. What an effect plugin calls from `build`.
+/// [`Effects`], [`Arena`] and [`Segments`] call for the effect. What an effect plugin calls from
+/// `build`.
 pub fn register_effect(
     app: &mut App,
     effect: Effect,
@@ -121,10 +131,12 @@ pub fn register_effect(
     systems: SystemsRecipe,
 ) {
     let world = app.world();
+    let none = Segments::default();
+    let segments = world.get_resource::<Segments>().unwrap_or(&none);
     let called_for = world
         .get_resource::<Effects>()
         .zip(world.get_resource::<Arena>())
-        .is_some_and(|(effects, arena)| effect.is_called_for(effects, arena.boundary));
+        .is_some_and(|(effects, arena)| effect.is_called_for(effects, arena.boundary, segments));
     if called_for {
         for &label in schedules {
             app.add_systems(label, systems().in_set(EffectSystems(effect)));
@@ -144,18 +156,22 @@ pub fn register_effect(
 }
 
 /// Makes the schedules hold exactly the systems of the registered effects that the world's
-/// [`Effects`] and [`Arena`] call for: adds the missing ones and removes the rest. Used when a
+/// [`Effects`], [`Arena`] and [`Segments`] call for: adds the missing ones and removes the rest. Used when a
 /// scene is reloaded while running.
 pub fn reconcile_effects(world: &mut World) {
     let effects = *world.resource::<Effects>();
     let boundary = world.resource::<Arena>().boundary;
+    let segments = world
+        .get_resource::<Segments>()
+        .cloned()
+        .unwrap_or_default();
     let registry = world.get_resource_or_init::<EffectRegistry>();
     let recipes = registry.recipes.clone();
     let scheduled = registry.scheduled.clone();
     let wanted: HashSet<Effect> = recipes
         .keys()
         .copied()
-        .filter(|e| e.is_called_for(&effects, boundary))
+        .filter(|e| e.is_called_for(&effects, boundary, &segments))
         .collect();
     let mut labels: Vec<Interned<dyn ScheduleLabel>> = Vec::new();
     for recipe in recipes.values() {

@@ -1,5 +1,6 @@
-//! Collision messages: a [`CircleHit`] per circle-circle impulse and a [`WallHit`] per wall hit,
-//! written by whichever solver made the hit when the scene opts in (`effects.hit_messages`).
+//! Collision messages: a [`CircleHit`] per circle-circle impulse and a [`WallHit`] per hit on an
+//! arena wall or a segment wall, written by whichever solver made the hit when the scene opts in
+//! (`effects.hit_messages`).
 //!
 //! The kernels (the discrete contact pass, the wall reflection, the event engine) record hits
 //! with circle indices into a [`HitLog`]; the solver's system turns indices into entities and
@@ -92,13 +93,22 @@ impl ArenaWall {
     }
 }
 
-/// One wall hit: a circle reflected off an arena wall.
+/// What a circle hit in a [`WallHit`]: one of the arena's walls or a segment wall inside it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Wall {
+    /// An edge of the arena.
+    Arena(ArenaWall),
+    /// A segment wall, by its index in [`Segments`](crate::segment::Segments).
+    Segment(u32),
+}
+
+/// One wall hit: a circle reflected off an arena wall or a segment wall.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
 pub struct WallHit<Id: Send + Sync + 'static = Entity> {
     /// The circle.
     pub circle: Id,
     /// The wall it hit.
-    pub wall: ArenaWall,
+    pub wall: Wall,
     /// Where it touched the wall.
     pub point: DVec2,
     /// Unit normal from the circle towards the wall.

@@ -25,11 +25,12 @@ pub mod render;
 pub mod run;
 pub mod scene;
 pub mod schedule;
+pub mod segment;
 pub mod spawn;
 
 use bevy::app::{PluginGroup, PluginGroupBuilder};
 
-use boundary::{PeriodicPlugin, WallsPlugin};
+use boundary::{PeriodicPlugin, SegmentsPlugin, WallsPlugin};
 use collide::CollidePlugin;
 use config::CirclesConfig;
 use diagnostics::DiagnosticsPlugin;
@@ -44,19 +45,20 @@ use spawn::SpawnPlugin;
 pub mod prelude {
     pub use crate::CirclesPlugins;
     pub use crate::arena::{Arena, Boundary};
-    pub use crate::boundary::{PeriodicPlugin, WallCollisions, WallsPlugin};
+    pub use crate::boundary::{PeriodicPlugin, SegmentsPlugin, WallCollisions, WallsPlugin};
     pub use crate::circle::CircleState;
     pub use crate::collide::{CollidePlugin, PairCollisions};
     pub use crate::components::{Mass, Position, Radius, Restitution, Tint, Velocity};
-    pub use crate::config::{CirclesConfig, Effects, MassModel, Solver, SpawnConfig};
+    pub use crate::config::{CirclesConfig, DropConfig, Effects, MassModel, Solver, SpawnConfig};
     pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin};
     pub use crate::effects::Effect;
     pub use crate::exact::ContinuousPlugin;
     pub use crate::forces::{DragPlugin, GravityPlugin};
-    pub use crate::hits::{ArenaWall, CircleHit, WallHit};
+    pub use crate::hits::{ArenaWall, CircleHit, Wall, WallHit};
     pub use crate::integrate::IntegratePlugin;
     pub use crate::scene::Scene;
     pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
+    pub use crate::segment::{Segment, Segments};
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
 }
 
@@ -65,7 +67,7 @@ pub use schedule::CircleSystems;
 
 /// The simulation as a plugin group: [`StepPlugin`] (first: the others build on it),
 /// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
-/// [`DragPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
+/// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
 /// [`ContinuousPlugin`] (the `swept` and `exact` solvers) and [`DiagnosticsPlugin`].
 ///
 /// An effect plugin schedules its systems only when the configuration calls for the effect,
@@ -102,6 +104,8 @@ impl PluginGroup for CirclesPlugins {
             effects,
             dt,
             circles,
+            segments,
+            drop,
         } = self.config;
         PluginGroupBuilder::start::<Self>()
             .add(StepPlugin {
@@ -109,14 +113,17 @@ impl PluginGroup for CirclesPlugins {
                 solver,
                 effects,
                 dt,
+                segments,
             })
             .add(SpawnPlugin {
                 config: spawn,
                 circles,
+                drop,
             })
             .add(IntegratePlugin)
             .add(GravityPlugin)
             .add(DragPlugin)
+            .add(SegmentsPlugin)
             .add(WallsPlugin)
             .add(PeriodicPlugin)
             .add(CollidePlugin)

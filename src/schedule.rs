@@ -18,6 +18,7 @@ use bevy::prelude::*;
 
 use crate::arena::Arena;
 use crate::config::{Effects, Solver};
+use crate::segment::Segments;
 
 /// The system sets of the simulation, in the order they run.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -69,7 +70,7 @@ pub struct StepTotals {
     pub sim_seconds: f64,
 }
 
-/// The core plugin: inserts the arena, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
+/// The core plugin: inserts the arena, segment walls, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
 /// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
 #[derive(Clone, Debug)]
 pub struct StepPlugin {
@@ -81,6 +82,8 @@ pub struct StepPlugin {
     pub effects: Effects,
     /// The fixed step in seconds.
     pub dt: f64,
+    /// The segment walls inside the arena.
+    pub segments: Segments,
 }
 
 impl Default for StepPlugin {
@@ -90,6 +93,7 @@ impl Default for StepPlugin {
             solver: Solver::default(),
             effects: Effects::default(),
             dt: 1.0 / 60.0,
+            segments: Segments::default(),
         }
     }
 }
@@ -102,6 +106,8 @@ impl Plugin for StepPlugin {
             .register_type::<Effects>()
             .insert_resource(self.solver)
             .insert_resource(self.effects)
+            .register_type::<Segments>()
+            .insert_resource(self.segments.clone())
             .insert_resource(Time::<Fixed>::from_duration(Duration::from_secs_f64(
                 self.dt,
             )))

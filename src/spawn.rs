@@ -1,5 +1,6 @@
 //! Seeded, non-overlapping random placement of circles ([`place_circles`], a plain function over
-//! plain data) and [`SpawnPlugin`], which spawns them at startup and on [`Respawn`] requests.
+//! plain data) and [`SpawnPlugin`], which spawns them at startup and on [`Respawn`] requests,
+//! and drops circles in one at a time while the simulation runs ([`DropConfig`]).
 //!
 //! Placement is rejection sampling against a uniform [`Grid`] of the circles already placed, so
 //! each attempt checks a 3×3 block of cells instead of every circle: 100k circles place in well
@@ -10,17 +11,22 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
 
 use crate::arena::Arena;
 use crate::circle::CircleState;
+use crate::components::Position;
 use crate::components::Radius;
-use crate::config::SpawnConfig;
+use crate::config::{DropConfig, SpawnConfig};
 use crate::error::FieldError;
 use crate::grid::{CellMembers, Grid};
 use crate::schedule::CircleSystems;
+use crate::schedule::StepTotals;
+use crate::segment::{Segment, SegmentCells, Segments};
 
 /// Places up to [`SpawnConfig::target_count`] non-overlapping circles inside `arena`, largest
-/// first, around the `fixed` circles already there (which are not returned).
+/// first, around the `fixed` circles already there (which are not returned) and clear of the
+/// segment walls.
 ///
 /// Returns the circles that fit, which is fewer than requested when the arena is too full, or
 /// which field of the arena or the rules ([`SpawnConfig::check`]) makes placing impossible.
@@ -31,14 +37,15 @@ use crate::schedule::CircleSystems;
 /// use moving_circles::spawn::place_circles;
 ///
 /// let config = SpawnConfig { count: 100, ..SpawnConfig::default() };
-/// let circles = place_circles(&Arena::default(), &config, &[]).unwrap();
+/// let circles = place_circles(&Arena::default(), &config, &[], &[]).unwrap();
 /// assert_eq!(circles.len(), 100);
-/// assert_eq!(circles, place_circles(&Arena::default(), &config, &[]).unwrap());
+/// assert_eq!(circles, place_circles(&Arena::default(), &config, &[], &[]).unwrap());
 /// ```
 pub fn place_circles(
     arena: &Arena,
     config: &SpawnConfig,
     fixed: &[CircleState],
+    segments: &[Segment],
 ) -> Result<Vec<CircleState>, FieldError> {
     arena.check()?;
     config.check(arena).map_err(|e| e.within("spawn"))?;
@@ -56,6 +63,7 @@ pub fn place_circles(
     // Fixed circles can be larger than any random one; the grid's cells must span the largest.
     let largest = fixed.iter().map(|c| c.radius).fold(r_max, f64::max);
     let mut grid = PlacementGrid::new(arena, largest, count + fixed.len());
+    let walls = SegmentCells::over_arena(segments, arena);
     let mut placed: Vec<CircleState> = Vec::with_capacity(count + fixed.len());
     for circle in fixed {
         grid.insert(circle.position, placed.len());
@@ -74,7 +82,9 @@ pub fn place_circles(
                     sample_between(&mut rng, lo.y, hi.y),
                 )
             })
-            .find(|&p| !grid.overlaps_any(p, r, &placed));
+            .find(|&p| {
+                !grid.overlaps_any(p, r, &placed) && walls.first_touched(segments, p, r).is_none()
+            });
         let Some(position) = spot else { continue };
         let speed = sample_between(&mut rng, s_min, s_max);
         let angle = rng.random_range(0.0..std::f64::consts::TAU);
@@ -195,16 +205,29 @@ pub struct SpawnPlugin {
     pub config: SpawnConfig,
     /// Circles to place exactly as given.
     pub circles: Vec<CircleState>,
+    /// Circles to drop in one at a time while it runs.
+    pub drop: Option<DropConfig>,
 }
 
 impl Plugin for SpawnPlugin {
     fn build(&self, app: &mut App) {
+        if let Some(drop) = self.drop {
+            app.insert_resource(drop);
+        }
         app.register_type::<SpawnConfig>()
+            .register_type::<DropConfig>()
             .insert_resource(self.config.clone())
             .insert_resource(FixedCircles(self.circles.clone()))
             .init_resource::<SpawnReport>()
+            .init_resource::<Dropped>()
             .add_message::<Respawn>()
             .add_systems(Startup, spawn_circles.in_set(CircleSystems::Spawn))
+            .add_systems(
+                FixedUpdate,
+                drop_circles
+                    .run_if(resource_exists::<DropConfig>)
+                    .before(CircleSystems::Step),
+            )
             .add_systems(
                 PreUpdate,
                 respawn_circles
@@ -214,16 +237,19 @@ impl Plugin for SpawnPlugin {
     }
 }
 
-/// Spawns the [`FixedCircles`], then random circles placed from the [`SpawnConfig`].
+/// Spawns the [`FixedCircles`], then random circles placed from the [`SpawnConfig`] around them
+/// and clear of the [`Segments`].
 fn spawn_circles(
     mut commands: Commands,
     arena: Res<Arena>,
     config: Res<SpawnConfig>,
-    fixed: Res<FixedCircles>,
+    around: (Res<FixedCircles>, Option<Res<Segments>>),
     mut report: ResMut<SpawnReport>,
 ) {
+    let (fixed, segments) = around;
     let requested = config.target_count(&arena);
-    let random = match place_circles(&arena, &config, &fixed.0) {
+    let walls = segments.as_ref().map_or(&[][..], |s| &s.0[..]);
+    let random = match place_circles(&arena, &config, &fixed.0, walls) {
         Ok(circles) => circles,
         Err(e) => {
             error!("cannot spawn circles: {e}");
@@ -250,6 +276,60 @@ fn spawn_circles(
     commands.spawn_batch(bundles);
 }
 
+/// How many circles the [`DropConfig`] has dropped since the last (re)spawn.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Dropped {
+    /// Circles dropped.
+    pub count: usize,
+    /// The [`SpawnReport::generation`] the count belongs to.
+    pub generation: u64,
+}
+
+/// Drops the next circle of the [`DropConfig`] when its time has come and its spot is free of
+/// circles and segment walls (else it waits for a later step).
+fn drop_circles(
+    mut commands: Commands,
+    rules: (Res<DropConfig>, Res<SpawnConfig>),
+    totals: Res<StepTotals>,
+    report: Res<SpawnReport>,
+    segments: Option<Res<Segments>>,
+    mut dropped: ResMut<Dropped>,
+    circles: Query<(&Position, &Radius)>,
+) {
+    let (config, spawn) = rules;
+    if dropped.generation != report.generation {
+        *dropped = Dropped {
+            count: 0,
+            generation: report.generation,
+        };
+    }
+    let due = dropped.count as f64 * config.every;
+    if dropped.count >= config.count || totals.sim_seconds + 1e-9 * config.every < due {
+        return;
+    }
+    // One random stream per drop: a drop that waits tries the same spot again.
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    rng.set_stream(dropped.count as u64);
+    let dx = sample_between(&mut rng, -config.spread, config.spread);
+    let (p, r) = (config.position + DVec2::new(dx, 0.0), config.radius);
+    let taken = circles
+        .iter()
+        .any(|(q, s)| p.distance_squared(q.0) < (r + s.0) * (r + s.0));
+    let walled = segments.is_some_and(|s| s.0.iter().any(|s| s.distance(p) < r));
+    if taken || walled {
+        return;
+    }
+    let circle = CircleState {
+        position: p,
+        velocity: config.velocity,
+        radius: r,
+        mass: spawn.mass.mass_of(r),
+        tint: hue_to_rgb(rng.random_range(0.0..1.0)),
+    };
+    commands.spawn(circle.bundle());
+    dropped.count += 1;
+}
+
 /// Despawns every circle and places a fresh set.
 fn respawn_circles(
     mut commands: Commands,
@@ -257,14 +337,14 @@ fn respawn_circles(
     circles: Query<Entity, With<Radius>>,
     arena: Res<Arena>,
     config: Res<SpawnConfig>,
-    fixed: Res<FixedCircles>,
+    around: (Res<FixedCircles>, Option<Res<Segments>>),
     report: ResMut<SpawnReport>,
 ) {
     requests.clear();
     for entity in &circles {
         commands.entity(entity).despawn();
     }
-    spawn_circles(commands, arena, config, fixed, report);
+    spawn_circles(commands, arena, config, around, report);
 }
 
 #[cfg(test)]
@@ -279,7 +359,7 @@ mod tests {
             radius: (0.3, 0.3),
             ..default()
         };
-        let circles = place_circles(&arena, &config, &[]).unwrap();
+        let circles = place_circles(&arena, &config, &[], &[]).unwrap();
         // A 2×2 box holds at most 9 circles of radius 0.3 (3 per row at spacing 0.6 + walls).
         assert!(
             !circles.is_empty() && circles.len() <= 9,
@@ -296,7 +376,7 @@ mod tests {
             radius: (0.6, 0.6),
             ..default()
         };
-        assert!(place_circles(&arena, &config, &[]).unwrap().is_empty());
+        assert!(place_circles(&arena, &config, &[], &[]).unwrap().is_empty());
     }
 
     #[test]
@@ -306,13 +386,13 @@ mod tests {
             radius: (0.5, 0.1),
             ..default()
         };
-        let err = place_circles(&arena, &bad_radius, &[]).unwrap_err();
+        let err = place_circles(&arena, &bad_radius, &[], &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.radius"), "{err}");
         let bad_speed = SpawnConfig {
             speed: (f64::NAN, 1.0),
             ..default()
         };
-        let err = place_circles(&arena, &bad_speed, &[]).unwrap_err();
+        let err = place_circles(&arena, &bad_speed, &[], &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.speed"), "{err}");
     }
 

@@ -100,7 +100,7 @@ proptest! {
         let (circles, arena) = unit_box_gas(&seeds, periodic);
         let t_end = 0.5;
         let (expected, collisions) = reference(circles.clone(), periodic, t_end);
-        let mut engine = EventEngine::new(&circles, &arena, 1.0, 1.0);
+        let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         // Several calls, as the App makes them, so state carried between steps is exercised.
         for step in 1..=12 {
             prop_assert!(engine.advance_to(t_end * step as f64 / 12.0, u64::MAX).is_ok());

@@ -75,10 +75,13 @@ fn every_counted_hit_is_one_message_under_every_solver() {
             assert_relative(solver, h.impulse, expected, 1e-9);
         }
         for (_, h) in &heard.walls {
-            let (_, normal) = h.wall.contact(h.point, &arena);
+            let Wall::Arena(wall) = h.wall else {
+                panic!("{solver}: a segment wall hit without segments: {h:?}");
+            };
+            let (_, normal) = wall.contact(h.point, &arena);
             assert_eq!(h.normal, normal, "{solver}: {h:?}");
             assert!(h.impulse > 0.0 && h.normal_speed > 0.0, "{solver}: {h:?}");
-            let on_wall = match h.wall {
+            let on_wall = match wall {
                 ArenaWall::Left => h.point.x == -4.0,
                 ArenaWall::Right => h.point.x == 4.0,
                 ArenaWall::Bottom => h.point.y == -3.0,

@@ -101,7 +101,7 @@ proptest! {
     ) {
         let (circles, arena) = unit_box_gas(&seeds, periodic);
         let energy = |e: &EventEngine| (0..e.len()).map(|i| 0.5 * circles[i].mass * e.velocity(i).length_squared()).sum::<f64>();
-        let mut engine = EventEngine::new(&circles, &arena, 1.0, 1.0);
+        let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         let e0 = energy(&engine);
         for step in 1..=20 {
             prop_assert!(engine.advance_to(step as f64 * 0.05, u64::MAX).is_ok());

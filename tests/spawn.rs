@@ -75,14 +75,15 @@ fn an_overfull_request_places_what_fits_and_reports_it() {
 #[test]
 fn the_same_seed_places_the_same_circles_and_another_seed_does_not() {
     let arena = Arena::default();
-    let a = place_circles(&arena, &SpawnConfig::default(), &[]).unwrap();
-    let b = place_circles(&arena, &SpawnConfig::default(), &[]).unwrap();
+    let a = place_circles(&arena, &SpawnConfig::default(), &[], &[]).unwrap();
+    let b = place_circles(&arena, &SpawnConfig::default(), &[], &[]).unwrap();
     let c = place_circles(
         &arena,
         &SpawnConfig {
             seed: 2,
             ..default()
         },
+        &[],
         &[],
     )
     .unwrap();

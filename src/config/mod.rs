@@ -14,8 +14,11 @@ use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::error::FieldError;
 pub use crate::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, check_vector};
+use crate::segment::Segments;
+pub use drop::DropConfig;
 pub use effects::Effects;
 
+mod drop;
 mod effects;
 
 /// Most circles any input may ask for: random spawns and particle files alike. Checked before
@@ -317,6 +320,10 @@ pub struct CirclesConfig {
     pub dt: f64,
     /// Circles placed exactly as given, before the random ones.
     pub circles: Vec<CircleState>,
+    /// Segment walls inside the arena (only on an arena with walls).
+    pub segments: Segments,
+    /// Circles dropped in one at a time while it runs, if any.
+    pub drop: Option<DropConfig>,
 }
 
 impl Default for CirclesConfig {
@@ -329,6 +336,8 @@ impl Default for CirclesConfig {
             effects: Effects::default(),
             dt: 1.0 / 60.0,
             circles: Vec::new(),
+            segments: Segments::default(),
+            drop: None,
         }
     }
 }
@@ -351,6 +360,10 @@ impl CirclesConfig {
         self.arena.check()?;
         self.effects.check()?;
         self.spawn.mass.check()?;
+        self.segments.check(&self.arena)?;
+        if let Some(drop) = &self.drop {
+            drop.check(&self.arena).map_err(|e| e.within("drop"))?;
+        }
         self.spawn.check(&self.arena).map_err(|e| e.within("spawn"))
     }
 }

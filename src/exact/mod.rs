@@ -25,6 +25,7 @@ use crate::components::{Restitution, SolverCircles};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
+use crate::segment::Segments;
 use engine::{EngineSnapshot, EventEngine, EventStats};
 
 /// Events a `swept` step may process per circle before the rest of the step is free flight.
@@ -43,6 +44,7 @@ pub struct ContinuousPlugin;
 impl Plugin for ContinuousPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<EngineState>()
+            .init_resource::<Segments>()
             .init_resource::<PairCollisions>()
             .init_resource::<WallCollisions>()
             .add_message::<CircleHit>()
@@ -64,6 +66,8 @@ pub struct EngineState {
     entities: Vec<Entity>,
     written: Vec<(DVec2, DVec2)>,
     setup: Option<(Arena, Effects, Solver)>,
+    /// The segment walls the engine was built with.
+    segments: Segments,
     last_stats: EventStats,
     /// Steps whose event budget ran out (their remainder was free flight).
     pub budget_exhausted: u64,
@@ -90,14 +94,15 @@ impl EngineState {
         &mut self,
         snapshot: EngineSnapshot,
         circles: &[(Entity, CircleState)],
-        setup: (Arena, Effects),
+        setup: (Arena, Effects, &Segments),
     ) -> Result<(), String> {
-        let (arena, effects) = setup;
+        let (arena, effects, segments) = setup;
         let states: Vec<CircleState> = circles.iter().map(|&(_, c)| c).collect();
         let mut engine = EventEngine::restore(
             snapshot,
             &states,
             &arena,
+            &segments.0,
             effects.restitution,
             effects.wall_restitution,
         )?;
@@ -112,6 +117,7 @@ impl EngineState {
         self.entities = circles.iter().map(|&(e, _)| e).collect();
         self.written = states.iter().map(|c| (c.position, c.velocity)).collect();
         self.setup = Some((arena, effects, Solver::Exact));
+        self.segments = segments.clone();
         Ok(())
     }
 }
@@ -124,6 +130,7 @@ fn gather_into_engine(
     solver: Res<Solver>,
     arena: Res<Arena>,
     effects: Res<Effects>,
+    segments: Res<Segments>,
     mut state: ResMut<EngineState>,
     own_restitution: Query<(), With<Restitution>>,
     circles: SolverCircles,
@@ -132,7 +139,9 @@ fn gather_into_engine(
     let setup = (*arena, *effects, *solver);
     let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
     let reason = match (&mut state.engine, *solver) {
-        (Some(engine), Solver::Exact) if state.setup == Some(setup) => {
+        (Some(engine), Solver::Exact)
+            if state.setup == Some(setup) && state.segments == *segments =>
+        {
             let known = (state.entities.as_slice(), state.written.as_slice());
             match moved_since(engine, known, &circles, restitution_of) {
                 Ok(moved) if moved.is_empty() => return,
@@ -149,7 +158,7 @@ fn gather_into_engine(
                 Err(reason) => reason,
             }
         }
-        (_, Solver::Exact) => "new solver, arena or effects",
+        (_, Solver::Exact) => "new solver, arena, segment walls or effects",
         _ => "swept builds every step",
     };
     if *solver == Solver::Exact {
@@ -162,6 +171,7 @@ fn gather_into_engine(
     let mut engine = EventEngine::new(
         &bodies,
         &arena,
+        &segments.0,
         effects.restitution,
         effects.wall_restitution,
     );
@@ -173,6 +183,9 @@ fn gather_into_engine(
     state.engine = Some(engine);
     state.entities = circles.iter().map(|(e, ..)| e).collect();
     state.setup = Some(setup);
+    if state.segments != *segments {
+        state.segments = segments.clone();
+    }
     state.rebuilds += 1;
 }
 

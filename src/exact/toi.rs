@@ -1,7 +1,9 @@
-//! Times of impact for straight-line motion: circle-circle and circle-wall. Plain functions,
-//! written to stay exact for touching and rounding-overlapped pairs.
+//! Times of impact for straight-line motion: circle-circle, circle-wall and circle-segment.
+//! Plain functions, written to stay exact for touching and rounding-overlapped pairs.
 
 use bevy::math::DVec2;
+
+use crate::segment::Segment;
 
 /// When two circles moving in straight lines first touch, if they do: the smallest `τ ≥ 0` with
 /// `|dp + dv·τ| = σ`, where `dp = p_b - p_a`, `dv = v_b - v_a` and `σ = r_a + r_b`.
@@ -39,6 +41,59 @@ pub fn wall_time_of_impact(x: f64, v: f64, lo: f64, hi: f64) -> Option<(f64, usi
     } else {
         None
     }
+}
+
+/// When a circle of radius `r` at `p` moving at `v` first touches `segment`, if it does: the
+/// soonest of touching a face (the contact point strictly between the ends) and touching an end
+/// (a point, like a circle of radius 0). A circle already touching or overlapping it by
+/// rounding and moving towards it touches it now (`Some(0)`); one moving away never does.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::exact::toi::segment_time_of_impact;
+/// use moving_circles::segment::Segment;
+///
+/// let wall = Segment::new(DVec2::new(0.0, -1.0), DVec2::new(0.0, 1.0));
+/// // 2 to the left, radius 0.5, speed 3 to the right: the gap of 1.5 closes at t = 0.5.
+/// let t = segment_time_of_impact(DVec2::new(-2.0, 0.0), DVec2::new(3.0, 0.0), 0.5, &wall);
+/// assert_eq!(t, Some(0.5));
+/// // Passing 0.4 above the upper end: the rounded end is hit, 0.3 before the centre is level
+/// // with it.
+/// let t = segment_time_of_impact(DVec2::new(-2.0, 1.4), DVec2::new(3.0, 0.0), 0.5, &wall);
+/// assert!((t.unwrap() - 1.7 / 3.0).abs() < 1e-12);
+/// ```
+pub fn segment_time_of_impact(p: DVec2, v: DVec2, r: f64, segment: &Segment) -> Option<f64> {
+    let ends = [segment.a, segment.b]
+        .into_iter()
+        .filter_map(|end| pair_time_of_impact(p - end, v, r));
+    let face = face_time_of_impact(p, v, r, segment);
+    face.into_iter().chain(ends).reduce(f64::min)
+}
+
+/// When the circle touches one face of `segment` at a point strictly between its ends.
+fn face_time_of_impact(p: DVec2, v: DVec2, r: f64, segment: &Segment) -> Option<f64> {
+    let d = segment.b - segment.a;
+    let length = d.length();
+    if length == 0.0 {
+        return None;
+    }
+    let u = d / length;
+    let n = u.perp();
+    let s = (p - segment.a).dot(n); // signed distance from the line
+    let w = v.dot(n); // speed along the normal
+    // Approaching the line from the side the centre is on (from exactly on it: any way).
+    let gap = if s > 0.0 && w < 0.0 {
+        (s - r) / -w
+    } else if s < 0.0 && w > 0.0 {
+        (-s - r) / w
+    } else if s == 0.0 && w != 0.0 {
+        0.0
+    } else {
+        return None;
+    };
+    let t = gap.max(0.0);
+    let along = (p + v * t - segment.a).dot(u);
+    (t.is_finite() && (0.0..=length).contains(&along)).then_some(t)
 }
 
 #[cfg(test)]
@@ -90,5 +145,56 @@ mod tests {
         assert!((t - 0.8).abs() < 1e-15 && w == 0);
         assert_eq!(wall_time_of_impact(0.95, 1.0, 0.1, 0.9), Some((0.0, 1)));
         assert_eq!(wall_time_of_impact(0.5, 0.0, 0.1, 0.9), None);
+    }
+
+    fn horizontal() -> Segment {
+        Segment::new(DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0))
+    }
+
+    #[test]
+    fn faces_are_hit_from_either_side_and_ends_head_on() {
+        let s = horizontal();
+        let down = segment_time_of_impact(DVec2::new(0.3, 2.0), DVec2::new(0.0, -1.0), 0.5, &s);
+        assert_eq!(down, Some(1.5));
+        let up = segment_time_of_impact(DVec2::new(0.3, -2.0), DVec2::new(0.0, 2.0), 0.5, &s);
+        assert_eq!(up, Some(0.75));
+        // Along the line into the right end: the end is a point, met at distance r.
+        let end = segment_time_of_impact(DVec2::new(3.0, 0.0), DVec2::new(-1.0, 0.0), 0.5, &s);
+        assert!((end.unwrap() - 1.5).abs() < 1e-15, "{end:?}");
+    }
+
+    #[test]
+    fn sliding_along_a_face_or_moving_away_never_hits() {
+        let s = horizontal();
+        // Touching the face, moving parallel to it: no face hit, only the tangent touch of
+        // the far end when it gets there (which turns no velocity).
+        let along = segment_time_of_impact(DVec2::new(-0.5, 0.5), DVec2::new(1.0, 0.0), 0.5, &s);
+        assert_eq!(along, Some(1.5));
+        // Touching it, moving away.
+        let away = segment_time_of_impact(DVec2::new(0.0, 0.5), DVec2::new(0.3, 1.0), 0.5, &s);
+        assert_eq!(away, None);
+        // Overlapping by rounding, approaching: now.
+        let now =
+            segment_time_of_impact(DVec2::new(0.0, 0.5 - 1e-16), DVec2::new(0.0, -1.0), 0.5, &s);
+        assert_eq!(now, Some(0.0));
+    }
+
+    #[test]
+    fn passing_beside_an_end_misses_or_grazes_it() {
+        let s = horizontal();
+        // Moving down, 0.6 to the right of the right end: misses (radius 0.5).
+        let miss = segment_time_of_impact(DVec2::new(1.6, 2.0), DVec2::new(0.0, -1.0), 0.5, &s);
+        assert_eq!(miss, None);
+        // 0.4 to the right: touches the end where the distance is 0.5, at height 0.3.
+        let graze = segment_time_of_impact(DVec2::new(1.4, 2.0), DVec2::new(0.0, -1.0), 0.5, &s);
+        assert!((graze.unwrap() - 1.7).abs() < 1e-12, "{graze:?}");
+    }
+
+    #[test]
+    fn a_fast_circle_far_away_hits_a_thin_segment() {
+        // 10 diameters per unit time, 30 diameters away: the face, not a miss.
+        let s = Segment::new(DVec2::new(0.0, -1.0), DVec2::new(0.0, 1.0));
+        let t = segment_time_of_impact(DVec2::new(-3.0, 0.2), DVec2::new(1.0, 0.0), 0.05, &s);
+        assert!((t.unwrap() - 2.95).abs() < 1e-12, "{t:?}");
     }
 }

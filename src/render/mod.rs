@@ -1,7 +1,7 @@
 //! The windowed app's side (cargo feature `render`): a camera that keeps the whole arena in view
 //! at its aspect ratio, one sprite per circle sharing a single disc texture (so thousands draw
-//! in a handful of batched draw calls, each with its own tint), and the [`hud`], [`input`] and
-//! [`screenshot`] plugins. The simulation never reads anything from here: `Position` is copied
+//! in a handful of batched draw calls, each with its own tint), a thin bar per segment wall, and
+//! the [`hud`], [`input`] and [`screenshot`] plugins. The simulation never reads anything from here: `Position` is copied
 //! into `Transform` once per frame, after the fixed steps.
 
 pub mod hud;
@@ -15,6 +15,7 @@ use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 
 use crate::arena::Arena;
 use crate::components::{Position, Radius, Tint};
+use crate::segment::Segments;
 
 /// Everything the window shows: arena, circles, HUD and the keyboard and mouse controls.
 #[derive(Clone, Copy, Debug, Default)]
@@ -26,6 +27,10 @@ impl Plugin for CirclesRenderPlugin {
             .add_plugins((hud::HudPlugin, input::InputPlugin))
             .add_systems(Startup, (create_disc_texture, spawn_camera_and_arena))
             .add_systems(Update, fit_view_to_arena.run_if(resource_changed::<Arena>))
+            .add_systems(
+                Update,
+                draw_segment_walls.run_if(resource_changed::<Segments>),
+            )
             .add_systems(
                 PostUpdate,
                 (attach_sprites, sync_transforms)
@@ -120,6 +125,42 @@ fn fit_view_to_arena(
     *camera.1 = transform;
     backdrop.0.custom_size = Some(arena.size().as_vec2());
     backdrop.1.translation = arena.center().as_vec2().extend(-1.0);
+}
+
+/// Marks a sprite that shows a segment wall.
+#[derive(Component, Clone, Copy, Debug)]
+pub struct SegmentSprite;
+
+/// Draws each segment wall as a thin bar (again when a reloaded scene changes them).
+fn draw_segment_walls(
+    mut commands: Commands,
+    arena: Res<Arena>,
+    segments: Res<Segments>,
+    drawn: Query<Entity, With<SegmentSprite>>,
+) {
+    for entity in &drawn {
+        commands.entity(entity).despawn();
+    }
+    let thickness = (arena.size().min_element() * 0.004) as f32;
+    let bars: Vec<_> = segments
+        .0
+        .iter()
+        .map(|s| {
+            let (a, b) = (s.a.as_vec2(), s.b.as_vec2());
+            let along = b - a;
+            (
+                SegmentSprite,
+                Sprite {
+                    color: Color::srgb(0.75, 0.78, 0.85),
+                    custom_size: Some(Vec2::new(along.length() + thickness, thickness)),
+                    ..default()
+                },
+                Transform::from_translation(((a + b) / 2.0).extend(-0.5))
+                    .with_rotation(Quat::from_rotation_z(along.to_angle())),
+            )
+        })
+        .collect();
+    commands.spawn_batch(bars);
 }
 
 /// Gives every new circle its sprite.

@@ -12,11 +12,12 @@ use bevy::tasks::futures_lite::AsyncReadExt;
 
 use super::schema::Scene;
 use crate::arena::Arena;
-use crate::config::{CirclesConfig, Effects, Solver, SpawnConfig};
+use crate::config::{CirclesConfig, DropConfig, Effects, Solver, SpawnConfig};
 use crate::effects::reconcile_effects;
 use crate::error::InputError;
 use crate::io::{MAX_SCENE_BYTES, printable, read_limited};
 use crate::schedule::allow_long_steps;
+use crate::segment::Segments;
 use crate::spawn::{FixedCircles, Respawn};
 
 /// A scene file, checked and turned into a configuration.
@@ -76,8 +77,13 @@ pub fn apply_config(world: &mut World, config: &CirclesConfig) {
     world.insert_resource::<Arena>(config.arena);
     world.insert_resource::<Solver>(config.solver);
     world.insert_resource::<Effects>(config.effects);
+    world.insert_resource::<Segments>(config.segments.clone());
     world.insert_resource::<SpawnConfig>(config.spawn.clone());
     world.insert_resource(FixedCircles(config.circles.clone()));
+    match config.drop {
+        Some(drop) => world.insert_resource(drop),
+        None => drop(world.remove_resource::<DropConfig>()),
+    }
     world
         .resource_mut::<Time<Fixed>>()
         .set_timestep(Duration::from_secs_f64(config.dt));

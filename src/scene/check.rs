@@ -19,6 +19,7 @@ use crate::config::{CirclesConfig, MIN_RADIUS_FRACTION, SpawnConfig, min_radius}
 use crate::error::{FieldError, InputError};
 use crate::io::{MAX_SCENE_BYTES, read_limited};
 use crate::range::{check_mass, check_vector};
+use crate::segment::{MAX_SEGMENTS, SegmentCells, Segments, check_end};
 
 impl Scene {
     /// Reads and checks a scene file into a configuration.
@@ -69,6 +70,7 @@ impl Scene {
                 ..SpawnConfig::default()
             },
         };
+        let segments = check_polylines(&self.segments, &arena).map_err(field_error)?;
         let mut config = CirclesConfig {
             arena,
             spawn,
@@ -76,6 +78,8 @@ impl Scene {
             effects: self.effects,
             dt: self.dt,
             circles: Vec::with_capacity(self.circles.len()),
+            segments,
+            drop: self.drop,
         };
         config.check().map_err(field_error)?;
         for (i, spec) in self.circles.iter().enumerate() {
@@ -111,6 +115,14 @@ impl Scene {
             check_separable(&config.circles, &arena).map_err(field_error)?;
             separate_overlaps(&mut config.circles, &arena);
         }
+        let walls = SegmentCells::over_arena(&config.segments.0, &arena);
+        for (i, c) in config.circles.iter().enumerate() {
+            if let Some(k) = walls.first_touched(&config.segments.0, c.position, c.radius) {
+                let (line, n) = polyline_of(&self.segments, k as usize);
+                let why = format!("overlaps segments[{line}] (its segment {n}: segment wall {k})");
+                return Err(field_error(FieldError::new(format!("circles[{i}]"), why)));
+            }
+        }
         if let Some((i, j, depth)) = first_overlap(&config.circles, &arena) {
             return Err(field_error(FieldError::new(
                 format!("circles[{j}]"),
@@ -121,6 +133,39 @@ impl Scene {
         }
         Ok(config)
     }
+}
+
+/// The segment walls of a scene's polylines, each checked: at least two points, every point
+/// inside `arena`, at most [`MAX_SEGMENTS`] in all (counted before any is made).
+fn check_polylines(polylines: &[Vec<DVec2>], arena: &Arena) -> Result<Segments, FieldError> {
+    let mut count = 0usize;
+    for (i, line) in polylines.iter().enumerate() {
+        if line.len() < 2 {
+            let why = format!("a polyline needs at least two points, got {}", line.len());
+            return Err(FieldError::new(format!("segments[{i}]"), why));
+        }
+        count = count.saturating_add(line.len() - 1);
+        for (k, &p) in line.iter().enumerate() {
+            check_end(&format!("segments[{i}][{k}]"), p, arena)?;
+        }
+    }
+    if count > MAX_SEGMENTS {
+        let why = format!("{count} segments; at most {MAX_SEGMENTS} are supported");
+        return Err(FieldError::new("segments", why));
+    }
+    Ok(Segments::from_polylines(polylines))
+}
+
+/// Which polyline segment wall `k` comes from, and its place in it.
+fn polyline_of(polylines: &[Vec<DVec2>], mut k: usize) -> (usize, usize) {
+    for (i, line) in polylines.iter().enumerate() {
+        let n = line.len().saturating_sub(1);
+        if k < n {
+            return (i, k);
+        }
+        k -= n;
+    }
+    (polylines.len(), k)
 }
 
 /// Checks one explicit circle: finite, positive radius, a mass in range or infinite (a static

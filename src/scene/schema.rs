@@ -1,5 +1,5 @@
 //! The scene file's schema: the RON a scene is written in ([`Scene`], [`ArenaSpec`],
-//! [`CircleSpec`]), every field with a default so a file names only what it changes, and
+//! [`CircleSpec`], segment walls as polylines), every field with a default so a file names only what it changes, and
 //! [`Scene::parse`], which reads the text and names the line and column of a syntax error or an
 //! unknown field. Checking the values is `check`'s job.
 
@@ -7,7 +7,7 @@ use bevy::math::DVec2;
 use serde::Deserialize;
 
 use crate::arena::Boundary;
-use crate::config::{Effects, MassModel, Solver, SpawnConfig};
+use crate::config::{DropConfig, Effects, MassModel, Solver, SpawnConfig};
 use crate::error::InputError;
 
 /// The arena as a scene file gives it.
@@ -78,6 +78,11 @@ pub struct Scene {
     pub spawn: Option<SpawnConfig>,
     /// Circles placed exactly.
     pub circles: Vec<CircleSpec>,
+    /// Circles dropped in one at a time while it runs, if any.
+    pub drop: Option<DropConfig>,
+    /// Segment walls, as polylines: each is a list of two or more points inside the arena,
+    /// joined in order (two points: one segment). Only on an arena with walls.
+    pub segments: Vec<Vec<DVec2>>,
     /// Push apart explicit circles that overlap instead of rejecting the scene.
     pub separate_overlaps: bool,
 }
@@ -94,6 +99,8 @@ impl Default for Scene {
             dt: 1.0 / 60.0,
             spawn: None,
             circles: Vec::new(),
+            segments: Vec::new(),
+            drop: None,
             separate_overlaps: false,
         }
     }

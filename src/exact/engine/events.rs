@@ -35,9 +35,12 @@ pub(super) enum Kind {
         axis: u8,
         up: bool,
     },
+    /// A segment wall hit; the event's `partner` is the segment.
+    Segment,
 }
 
-/// A circle's pending event (its time lives in the queue).
+/// A circle's pending event (its time lives in the queue): `partner` is the other circle of a
+/// pair event, the segment of a segment event, [`NONE`] otherwise.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub(super) struct Event {
     pub(super) kind: Kind,

@@ -1,5 +1,5 @@
 //! The event-driven engine: circles fly in straight lines between events, and events (pair
-//! collisions, wall hits, cell crossings) are processed in time order.
+//! collisions, wall hits, segment wall hits, cell crossings) are processed in time order.
 //!
 //! Each circle has exactly one pending event, its soonest, held in an indexed [`EventQueue`].
 //! A pair event remembers its partner's collision counter; if the partner has collided since,
@@ -9,16 +9,20 @@
 //! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)`. A [`Grid`] of cells
 //! at least one largest diameter wide, with memberships kept up to date by cell-crossing
 //! events, keeps prediction local. A crossing changes no trajectory, so it bumps no counter
-//! (events other circles hold with the crosser stay valid). Everything is f64.
+//! (events other circles hold with the crosser stay valid). Segment walls are listed in the
+//! cells they pass within a largest radius of ([`SegmentCells`]), so a circle looks only at its
+//! own cell's list, again after each crossing. Everything is f64.
 
 mod events;
 mod predict;
 mod snapshot;
+mod walls;
 
 pub use events::{BudgetExhausted, EventStats};
 pub use snapshot::EngineSnapshot;
 
 use events::{BestPair, Event, Kind, Motion, NO_PAIR};
+use walls::walls_inside;
 
 use bevy::math::DVec2;
 
@@ -30,7 +34,8 @@ use crate::collide::contact::{
     apply_impulse, combine_restitution, contact_normal, work_by_immovable,
 };
 use crate::grid::{CellMembers, Grid, NONE};
-use crate::hits::{ArenaWall, CircleHit, HitLog, WallHit};
+use crate::hits::{CircleHit, HitLog};
+use crate::segment::{Segment, SegmentCells};
 
 /// An event-driven simulation of circles.
 ///
@@ -44,7 +49,7 @@ use crate::hits::{ArenaWall, CircleHit, HitLog, WallHit};
 ///     CircleState::new(DVec2::new(-2.0, 0.0), DVec2::new(1.0, 0.0), 0.5),
 ///     CircleState::new(DVec2::new(2.0, 0.0), DVec2::new(-1.0, 0.0), 0.5),
 /// ];
-/// let mut engine = EventEngine::new(&circles, &Arena::default(), 1.0, 1.0);
+/// let mut engine = EventEngine::new(&circles, &Arena::default(), &[], 1.0, 1.0);
 /// engine.advance_to(2.0, u64::MAX).unwrap();
 /// assert_eq!(engine.stats().pair_collisions, 1); // they met at t = 1.5
 /// assert_eq!(engine.velocity(0), DVec2::new(-1.0, 0.0));
@@ -70,6 +75,9 @@ pub struct EventEngine {
     cell_x: Vec<u32>,
     cell_y: Vec<u32>,
     stats: EventStats,
+    /// Segment walls (none on a periodic arena), and the cells they pass near.
+    segments: Vec<Segment>,
+    segment_cells: SegmentCells,
     /// Each circle's own restitution, or empty when all take the engine's.
     own_restitution: Vec<f64>,
     /// Hits since the last [`EventEngine::drain_hits`], when recording.
@@ -79,17 +87,18 @@ pub struct EventEngine {
 impl EventEngine {
     /// Builds the engine at time 0 and predicts every circle's first event. Circles must have
     /// finite state; with walls their centres must lie within `[min + r, max - r]` (a centre
-    /// just outside by rounding is treated as touching the wall).
+    /// just outside by rounding is treated as touching the wall) and clear of the `segments`
+    /// (ignored on a periodic arena).
     pub fn new(
         circles: &[CircleState],
         arena: &Arena,
+        segments: &[Segment],
         restitution: f64,
         wall_restitution: f64,
     ) -> Self {
         let n = circles.len();
         let size = arena.size();
-        let largest = circles.iter().map(|c| c.radius).fold(0.0f64, f64::max);
-        let grid = Grid::tiling(arena.min, size, 2.0 * largest, n, arena.is_periodic());
+        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments);
         let mut engine = Self {
             arena: *arena,
             period: size,
@@ -126,6 +135,8 @@ impl EventEngine {
             cell_x: vec![0; n],
             cell_y: vec![0; n],
             stats: EventStats::default(),
+            segments,
+            segment_cells,
             own_restitution: Vec::new(),
             hits: None,
         };
@@ -239,6 +250,7 @@ impl EventEngine {
                 Kind::Pair => self.collide(i, event.partner as usize),
                 Kind::Wall { axis } => self.hit_wall(i, axis as usize),
                 Kind::Cell { axis, up } => self.cross_cell(i, axis as usize, up),
+                Kind::Segment => self.hit_segment(i, event.partner as usize),
                 Kind::Idle => unreachable!("idle circles wait at +∞"),
             }
         }
@@ -338,51 +350,6 @@ impl EventEngine {
         self.counter[j] += 1;
         self.predict(i);
         self.predict(j);
-    }
-
-    fn hit_wall(&mut self, i: usize, axis: usize) {
-        if self.arena.is_periodic() {
-            return;
-        }
-        self.advance_circle(i, self.now);
-        let (min, max) = (self.arena.min, self.arena.max);
-        let e = match self.own_restitution.as_slice() {
-            [] => self.wall_restitution,
-            own => combine_restitution(own[i], self.wall_restitution),
-        };
-        let m = &mut self.motion[i];
-        let (lo, hi) = (min[axis] + m.radius, max[axis] - m.radius);
-        let v = m.vel[axis];
-        // Snap onto the wall (the event time puts it there up to rounding) and reflect.
-        let high = v > 0.0;
-        m.pos[axis] = if high { hi } else { lo };
-        let new_v = -e * v;
-        m.vel[axis] = new_v;
-        let impulse = if self.inv_mass[i] > 0.0 {
-            (new_v - v).abs() / self.inv_mass[i]
-        } else {
-            f64::INFINITY
-        };
-        if impulse.is_finite() {
-            self.stats.wall_impulse += impulse;
-        }
-        self.stats.wall_collisions += 1;
-        if let Some(log) = &mut self.hits {
-            let wall = ArenaWall::on_axis(axis, high);
-            let (point, normal) = wall.contact(m.pos, &self.arena);
-            log.walls.push(WallHit {
-                circle: i as u32,
-                wall,
-                point,
-                normal,
-                impulse,
-                normal_speed: v.abs(),
-                time: self.now,
-                count: 1,
-            });
-        }
-        self.counter[i] += 1;
-        self.predict(i);
     }
 
     fn cross_cell(&mut self, i: usize, axis: usize, up: bool) {

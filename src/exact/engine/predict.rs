@@ -1,4 +1,5 @@
-//! Prediction: a circle's soonest event among its best pair, a wall hit and a cell crossing.
+//! Prediction: a circle's soonest event among its best pair, a wall hit, a segment wall hit and
+//! a cell crossing.
 //!
 //! Whenever a trajectory changes, its owner looks at every neighbour (the 3×3 block of cells);
 //! after a cell crossing, which changes no trajectory, the crosser looks only at the three cells
@@ -9,7 +10,7 @@ use bevy::math::DVec2;
 
 use super::EventEngine;
 use super::events::{BestPair, Event, Kind, NO_PAIR};
-use crate::exact::toi::{pair_time_of_impact, wall_time_of_impact};
+use crate::exact::toi::{pair_time_of_impact, segment_time_of_impact, wall_time_of_impact};
 use crate::grid::NONE;
 
 impl EventEngine {
@@ -84,7 +85,8 @@ impl EventEngine {
         self.schedule(i);
     }
 
-    /// Sets circle `i`'s event to the soonest of its best pair, a wall hit and a cell crossing.
+    /// Sets circle `i`'s event to the soonest of its best pair, a wall hit, a hit on a segment
+    /// wall listed in its cell and a cell crossing.
     fn schedule(&mut self, i: usize) {
         let m = self.motion[i];
         let p = m.at(self.now);
@@ -101,16 +103,22 @@ impl EventEngine {
                 partner_count: best.partner_count,
             },
         );
-        let mut consider = |t: f64, kind: Kind| {
+        let mut consider = |t: f64, kind: Kind, partner: u32| {
             if t < time {
                 time = t;
                 event = Event {
                     kind,
-                    partner: NONE,
+                    partner,
                     partner_count: 0,
                 };
             }
         };
+        for &k in self.segment_cells.in_cell(self.cell_index(i)) {
+            let segment = &self.segments[k as usize];
+            if let Some(t) = segment_time_of_impact(p, m.vel, m.radius, segment) {
+                consider(self.now + t, Kind::Segment, k);
+            }
+        }
         let walls = !self.grid.periodic;
         let (min, max): (DVec2, DVec2) = (self.arena.min, self.arena.max);
         for axis in 0..2u8 {
@@ -123,7 +131,7 @@ impl EventEngine {
                 && let Some((t, _)) =
                     wall_time_of_impact(p[a], v, min[a] + m.radius, max[a] - m.radius)
             {
-                consider(self.now + t, Kind::Wall { axis });
+                consider(self.now + t, Kind::Wall { axis }, NONE);
             }
             // Cell crossing along this axis (none past the outer cells of a walled box).
             let (cell, last) = if a == 0 {
@@ -139,6 +147,7 @@ impl EventEngine {
             consider(
                 self.now + ((edge - p[a]) / v).max(0.0),
                 Kind::Cell { axis, up },
+                NONE,
             );
         }
         self.event[i] = event;

@@ -6,12 +6,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::EventEngine;
 use super::events::{BestPair, Event, EventStats, Kind, Motion};
+use super::{EventEngine, walls_inside};
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::exact::queue::EventQueue;
-use crate::grid::{CellMembers, Grid, NONE};
+use crate::grid::{CellMembers, NONE};
+use crate::segment::Segment;
 
 /// An [`EventEngine`]'s state between two events, as data ([`EventEngine::snapshot`],
 /// [`EventEngine::restore`]).
@@ -53,6 +54,7 @@ impl EventEngine {
         snapshot: EngineSnapshot,
         circles: &[CircleState],
         arena: &Arena,
+        segments: &[Segment],
         restitution: f64,
         wall_restitution: f64,
     ) -> Result<Self, String> {
@@ -76,8 +78,7 @@ impl EventEngine {
             return Err(format!("engine clock {} is not finite", s.now));
         }
         let size = arena.size();
-        let largest = circles.iter().map(|c| c.radius).fold(0.0f64, f64::max);
-        let grid = Grid::tiling(arena.min, size, 2.0 * largest, n, arena.is_periodic());
+        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments);
         let partner_ok = |p: u32, i: usize| p == NONE || (p as usize) < n && p as usize != i;
         for (i, c) in circles.iter().enumerate() {
             let m = &s.motion[i];
@@ -91,6 +92,7 @@ impl EventEngine {
                 Kind::Idle => s.time[i] == f64::INFINITY,
                 Kind::Pair => event.partner != NONE && partner_ok(event.partner, i),
                 Kind::Wall { axis } | Kind::Cell { axis, .. } => axis < 2,
+                Kind::Segment => (event.partner as usize) < segments.len(),
             };
             let best = s.best_pair[i];
             if !fits
@@ -123,6 +125,8 @@ impl EventEngine {
             cell_x: s.cell_x,
             cell_y: s.cell_y,
             stats: s.stats,
+            segments,
+            segment_cells,
             own_restitution: Vec::new(),
             hits: None,
         })
@@ -163,18 +167,18 @@ mod tests {
     #[test]
     fn a_restored_engine_goes_on_bit_for_bit_as_the_original() {
         let (circles, arena) = gas();
-        let mut original = EventEngine::new(&circles, &arena, 1.0, 1.0);
+        let mut original = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         original.advance_to(1.0, u64::MAX).unwrap();
         let now = circles_now(&original, &circles);
         let mut restored =
-            EventEngine::restore(original.snapshot(), &now, &arena, 1.0, 1.0).unwrap();
+            EventEngine::restore(original.snapshot(), &now, &arena, &[], 1.0, 1.0).unwrap();
         original.advance_to(5.0, u64::MAX).unwrap();
         restored.advance_to(5.0, u64::MAX).unwrap();
         assert!(original.stats().pair_collisions > 50);
         assert_eq!(restored.snapshot(), original.snapshot());
         // Rebuilding from the positions instead predicts from a different origin: the runs
         // part by rounding, which is why checkpoints carry the engine.
-        let mut rebuilt = EventEngine::new(&now, &arena, 1.0, 1.0);
+        let mut rebuilt = EventEngine::new(&now, &arena, &[], 1.0, 1.0);
         rebuilt.advance_to(4.0, u64::MAX).unwrap();
         let moved = |e: &EventEngine| (0..64).map(|i| e.position(i)).collect::<Vec<_>>();
         assert_ne!(moved(&rebuilt), moved(&original));
@@ -183,7 +187,7 @@ mod tests {
     #[test]
     fn a_damaged_snapshot_is_refused_not_followed() {
         let (circles, arena) = gas();
-        let mut engine = EventEngine::new(&circles, &arena, 1.0, 1.0);
+        let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         engine.advance_to(0.5, u64::MAX).unwrap();
         let now = circles_now(&engine, &circles);
         let good = engine.snapshot();
@@ -206,10 +210,10 @@ mod tests {
             let mut bad = good.clone();
             damage(&mut bad);
             assert!(
-                EventEngine::restore(bad, &now, &arena, 1.0, 1.0).is_err(),
+                EventEngine::restore(bad, &now, &arena, &[], 1.0, 1.0).is_err(),
                 "damage {k} was accepted"
             );
         }
-        assert!(EventEngine::restore(good, &now, &arena, 1.0, 1.0).is_ok());
+        assert!(EventEngine::restore(good, &now, &arena, &[], 1.0, 1.0).is_ok());
     }
 }

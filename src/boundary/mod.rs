@@ -1,5 +1,6 @@
 //! The arena's edges: [`WallsPlugin`], walls with the seed's reflection rule in vector form
-//! ([`reflect_off_walls`], a plain function), or [`PeriodicPlugin`], wrap-around; both in
+//! ([`reflect_off_walls`], a plain function), or [`PeriodicPlugin`], wrap-around; and the
+//! segment walls inside the arena ([`segments`]), with the same rule. All in
 //! [`CircleSystems::Boundary`] of the discrete solvers. Wall hits are counted here
 //! ([`WallCollisions`]), by whichever solver makes them, and written as
 //! [`WallHit`] messages when the scene asks for them.
@@ -17,8 +18,12 @@ use crate::collide::contact::combine_restitution;
 use crate::components::{Position, SolverCircles};
 use crate::config::Effects;
 use crate::effects::{Effect, register_effect};
-use crate::hits::{ArenaWall, HitLog, WallHit};
+use crate::hits::{ArenaWall, HitLog, Wall, WallHit};
 use crate::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
+
+pub mod segments;
+
+pub use segments::SegmentsPlugin;
 
 /// Keeps every circle inside the [`Arena`] by reflecting it off the walls, when the arena has
 /// walls. (The continuous solvers hit the walls inside their own step.)
@@ -229,7 +234,7 @@ fn record_wall_hits(
         let (point, normal) = wall.contact(after.0, arena);
         log.walls.push(WallHit {
             circle: i,
-            wall,
+            wall: Wall::Arena(wall),
             point,
             normal,
             impulse: if mass.is_finite() {

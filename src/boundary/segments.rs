@@ -1,0 +1,210 @@
+//! Segment walls under the discrete solvers: [`SegmentsPlugin`] schedules
+//! [`bounce_off_segments`] when the scene has [`Segments`], and [`reflect_off_segment`] is its
+//! kernel: the arena walls' rule, turned to the segment's normal at the point nearest the
+//! circle (at an end, the normal points from the end to the centre).
+//!
+//! Like the arena walls, a step that carries a circle across a thin segment is not noticed: a
+//! discrete step only sees where circles end. `swept` and `exact` hit segments at the exact time
+//! of impact instead (`exact::toi::segment_time_of_impact`).
+
+use bevy::ecs::schedule::ScheduleLabel;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::WallCollisions;
+use crate::arena::Arena;
+use crate::collide::contact::combine_restitution;
+use crate::components::SolverCircles;
+use crate::config::Effects;
+use crate::effects::{Effect, EffectSystems, register_effect};
+use crate::hits::{HitLog, Wall, WallHit};
+use crate::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
+use crate::segment::{Segment, SegmentCells, Segments};
+
+/// Reflects circles off the scene's segment walls (before the arena walls, which then have the
+/// last word on keeping every circle inside).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SegmentsPlugin;
+
+impl Plugin for SegmentsPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<Segments>()
+            .init_resource::<WallCollisions>()
+            .add_message::<WallHit>();
+        register_effect(app, Effect::Segments, &[CircleStep.intern()], || {
+            bounce_off_segments
+                .in_set(CircleSystems::Boundary)
+                .before(EffectSystems(Effect::Walls))
+                .into_configs()
+        });
+    }
+}
+
+/// A circle's bounce off a segment wall.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SegmentBounce {
+    /// The point of the segment nearest the circle's centre before the bounce.
+    pub point: DVec2,
+    /// Unit normal from the circle towards the segment.
+    pub normal: DVec2,
+    /// Speed at which the circle approached, before the bounce (positive).
+    pub normal_speed: f64,
+}
+
+/// Reflects a circle of `radius` at `position` moving at `velocity` off `segment`, with the
+/// arena walls' rule: if it overlaps the segment and moves into it, it is mirrored back out
+/// along the normal at the nearest point and its normal velocity is reversed and scaled by
+/// `restitution` (the bounce is returned); if it overlaps but already moves away, it is only put
+/// back to touching. A centre exactly on the segment goes back the way it came.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::boundary::segments::reflect_off_segment;
+/// use moving_circles::segment::Segment;
+///
+/// let floor = Segment::new(DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0));
+/// let (mut p, mut v) = (DVec2::new(0.0, 0.4), DVec2::new(1.0, -2.0));
+/// let bounce = reflect_off_segment(&mut p, &mut v, 0.5, &floor, 1.0).unwrap();
+/// assert_eq!(v, DVec2::new(1.0, 2.0)); // the seed's angle rule on a horizontal wall
+/// assert!((p.y - 0.6).abs() < 1e-12 && bounce.normal == DVec2::new(0.0, -1.0));
+/// ```
+pub fn reflect_off_segment(
+    position: &mut DVec2,
+    velocity: &mut DVec2,
+    radius: f64,
+    segment: &Segment,
+    restitution: f64,
+) -> Option<SegmentBounce> {
+    let (point, out, distance) = segment.contact(*position, *velocity);
+    if distance >= radius {
+        return None;
+    }
+    let vn = velocity.dot(out);
+    if vn >= 0.0 {
+        *position = point + out * radius;
+        return None;
+    }
+    *position += out * (2.0 * (radius - distance));
+    *velocity -= out * ((1.0 + restitution) * vn);
+    Some(SegmentBounce {
+        point,
+        normal: -out,
+        normal_speed: -vn,
+    })
+}
+
+/// Applies [`reflect_off_segment`] to every circle and each segment near it (with its own
+/// restitution combined with the walls', if it has one), counts the bounces as wall hits and,
+/// with `effects.hit_messages`, writes a [`WallHit`] per bounce.
+#[allow(clippy::too_many_arguments)]
+fn bounce_off_segments(
+    arena: Res<Arena>,
+    segments: Res<Segments>,
+    effects: Res<Effects>,
+    clock: (Res<StepDt>, Res<SubstepStart>),
+    mut walls: ResMut<WallCollisions>,
+    mut cells: Local<Option<SegmentCells>>,
+    mut scratch: Local<(HitLog, Vec<Entity>, Vec<u32>)>,
+    mut messages: MessageWriter<WallHit>,
+    mut circles: SolverCircles,
+) {
+    if cells.is_none() || segments.is_changed() || arena.is_changed() {
+        *cells = Some(SegmentCells::over_arena(&segments.0, &arena));
+    }
+    let Some(cells) = cells.as_ref() else { return };
+    let (log, entities, near) = &mut *scratch;
+    let (mut hits, mut impulse) = (0u64, 0.0f64);
+    for (entity, mut position, mut velocity, radius, mass, own) in &mut circles {
+        near.clear();
+        cells.near(position.0, radius.0, |k| near.push(k));
+        if near.is_empty() {
+            continue;
+        }
+        near.sort_unstable();
+        near.dedup();
+        let e = own.map_or(effects.wall_restitution, |own| {
+            combine_restitution(own.0, effects.wall_restitution)
+        });
+        let (mut p, mut v) = (position.0, velocity.0);
+        for &k in near.iter() {
+            let before = v;
+            let Some(bounce) =
+                reflect_off_segment(&mut p, &mut v, radius.0, &segments.0[k as usize], e)
+            else {
+                continue;
+            };
+            hits += 1;
+            let delta = mass.0 * (v - before).length();
+            if delta.is_finite() {
+                impulse += delta;
+            }
+            if effects.hit_messages {
+                log.walls.push(WallHit {
+                    circle: entities.len() as u32,
+                    wall: Wall::Segment(k),
+                    point: bounce.point,
+                    normal: bounce.normal,
+                    impulse: if mass.0.is_finite() {
+                        delta
+                    } else {
+                        f64::INFINITY
+                    },
+                    normal_speed: bounce.normal_speed,
+                    time: 0.0,
+                    count: 1,
+                });
+                entities.push(entity);
+            }
+        }
+        if p != position.0 {
+            position.0 = p;
+        }
+        if v != velocity.0 {
+            velocity.0 = v;
+        }
+    }
+    walls.count = walls.count.saturating_add(hits);
+    walls.impulse += impulse;
+    if effects.hit_messages {
+        let (dt, start) = clock;
+        log.send_wall_hits(|i| entities[i as usize], start.0 + dt.0, &mut messages);
+        entities.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn floor() -> Segment {
+        Segment::new(DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0))
+    }
+
+    #[test]
+    fn an_end_reflects_along_the_line_from_it_to_the_centre() {
+        // Head on into the right end along the segment's line.
+        let (mut p, mut v) = (DVec2::new(1.4, 0.0), DVec2::new(-2.0, 0.0));
+        let bounce = reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 1.0).unwrap();
+        assert_eq!(v, DVec2::new(2.0, 0.0));
+        assert!((p.x - 1.6).abs() < 1e-12, "{p}");
+        assert_eq!((bounce.point, bounce.normal), (DVec2::X, -DVec2::X));
+    }
+
+    #[test]
+    fn a_circle_moving_away_is_only_put_back() {
+        let (mut p, mut v) = (DVec2::new(0.0, -0.3), DVec2::new(0.0, -1.0));
+        assert_eq!(
+            reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 1.0),
+            None
+        );
+        assert_eq!((p, v), (DVec2::new(0.0, -0.5), DVec2::new(0.0, -1.0)));
+    }
+
+    #[test]
+    fn a_centre_on_the_segment_goes_back_the_way_it_came() {
+        let (mut p, mut v) = (DVec2::ZERO, DVec2::new(0.0, 3.0));
+        reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 0.5).unwrap();
+        assert_eq!(v, DVec2::new(0.0, -1.5));
+        assert_eq!(p, DVec2::new(0.0, -1.0));
+    }
+}
