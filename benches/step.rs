@@ -1,7 +1,7 @@
 //! Whole-App benchmarks: one `app.update()` (exactly one fixed step) of a headless app, after
 //! `finish()`, spawning and one warm-up step. Per solver on gases of growing N, and the price of
 //! effects: a no-collision scene against the same scene with collisions and against bare
-//! integration; and collision messages off and on.
+//! integration; collision messages off and on; and a gas without and among 2000 segment walls.
 //!
 //! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver and
 //! N = 1M for `discrete`.
@@ -94,5 +94,34 @@ fn hit_messages(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, solvers, effects, hit_messages);
+/// What segment walls cost: a walled 10k gas with collisions, without segments and among 2000
+/// short bars (a 50 × 40 grid of them), under `discrete` and `exact`.
+fn segments(c: &mut Criterion) {
+    let n = 10_000;
+    for solver in [Solver::Discrete, Solver::Exact] {
+        for bars in [0, 2000] {
+            let config = gas(n, solver);
+            let arena = config.arena.with_boundary(Boundary::Walls);
+            let cell = arena.size() / bevy::math::DVec2::new(50.0, 40.0);
+            let segments = (0..bars)
+                .map(|k| {
+                    let centre = arena.min
+                        + cell
+                            * bevy::math::DVec2::new((k % 50) as f64 + 0.5, (k / 50) as f64 + 0.5);
+                    let half = cell * 0.15;
+                    Segment::new(centre - half, centre + half)
+                })
+                .collect();
+            let config = CirclesConfig {
+                arena,
+                segments: Segments(segments),
+                ..config
+            };
+            let name = format!("{solver}/{bars}");
+            bench_config(c, "step_segments", BenchmarkId::new(name, n), n, config);
+        }
+    }
+}
+
+criterion_group!(benches, solvers, effects, hit_messages, segments);
 criterion_main!(benches);
