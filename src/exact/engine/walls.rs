@@ -29,18 +29,11 @@ impl EventEngine {
         m.pos[axis] = if high { hi } else { lo };
         let new_v = -e * v;
         m.vel[axis] = new_v;
-        let impulse = if self.inv_mass[i] > 0.0 {
-            (new_v - v).abs() / self.inv_mass[i]
-        } else {
-            f64::INFINITY
-        };
-        if impulse.is_finite() {
-            self.stats.wall_impulse += impulse;
-        }
-        self.stats.wall_collisions += 1;
+        let centre = m.pos;
+        let impulse = self.count_wall_hit(i, (new_v - v).abs());
         if let Some(log) = &mut self.hits {
             let wall = ArenaWall::on_axis(axis, high);
-            let (point, normal) = wall.contact(m.pos, &self.arena);
+            let (point, normal) = wall.contact(centre, &self.arena);
             log.walls.push(WallHit {
                 circle: i as u32,
                 wall: Wall::Arena(wall),
@@ -54,6 +47,21 @@ impl EventEngine {
         }
         self.counter[i] += 1;
         self.predict(i);
+    }
+
+    /// Counts a wall hit that changed circle `i`'s velocity by `speed_change`, and returns the
+    /// momentum the wall took up (infinite for an immovable circle, which is not added up).
+    fn count_wall_hit(&mut self, i: usize, speed_change: f64) -> f64 {
+        let impulse = if self.inv_mass[i] > 0.0 {
+            speed_change / self.inv_mass[i]
+        } else {
+            f64::INFINITY
+        };
+        if impulse.is_finite() {
+            self.stats.wall_impulse += impulse;
+        }
+        self.stats.wall_collisions += 1;
+        impulse
     }
 
     pub(super) fn hit_segment(&mut self, i: usize, k: usize) {
@@ -71,15 +79,8 @@ impl EventEngine {
             m.pos = point + out * m.radius;
             let before = m.vel;
             m.vel -= out * ((1.0 + e) * vn);
-            let impulse = if self.inv_mass[i] > 0.0 {
-                (m.vel - before).length() / self.inv_mass[i]
-            } else {
-                f64::INFINITY
-            };
-            if impulse.is_finite() {
-                self.stats.wall_impulse += impulse;
-            }
-            self.stats.wall_collisions += 1;
+            let speed_change = (m.vel - before).length();
+            let impulse = self.count_wall_hit(i, speed_change);
             if let Some(log) = &mut self.hits {
                 log.walls.push(WallHit {
                     circle: i as u32,
