@@ -6,10 +6,12 @@
 //! the event is stale, and since nothing can have happened to the owner before it, the owner is
 //! simply predicted again from that moment ([`predict`]).
 //!
-//! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)`. A [`Grid`] of cells
-//! at least one largest diameter wide, with memberships kept up to date by cell-crossing
-//! events, keeps prediction local. A crossing changes no trajectory, so it bumps no counter
-//! (events other circles hold with the crosser stay valid). Segment walls are listed in the
+//! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)`, its reference point
+//! moved only where its course changes, and every event time is worked out from reference
+//! points, so the run does not depend on the cells. A [`Grid`] of cells at least one largest
+//! diameter wide and sized to the density ([`walls::cell_width`]), with memberships kept up to
+//! date by cell-crossing events, keeps prediction local. A crossing changes no trajectory, so it
+//! bumps no counter (events other circles hold with the crosser stay valid). Segment walls are listed in the
 //! cells they pass within a largest radius of ([`SegmentCells`]), so a circle looks only at its
 //! own cell's list, again after each crossing. Everything is f64.
 
@@ -22,7 +24,7 @@ pub use events::{BudgetExhausted, EventStats};
 pub use snapshot::EngineSnapshot;
 
 use events::{BestPair, Event, Kind, Motion, NO_PAIR};
-use walls::walls_inside;
+use walls::{cell_width, walls_inside};
 
 use bevy::math::DVec2;
 
@@ -96,9 +98,27 @@ impl EventEngine {
         restitution: f64,
         wall_restitution: f64,
     ) -> Self {
+        let width = cell_width(arena, circles);
+        Self::with_cells(
+            circles,
+            arena,
+            segments,
+            (restitution, wall_restitution),
+            width,
+        )
+    }
+
+    /// [`EventEngine::new`] on cells at least `width` wide (and a largest diameter).
+    fn with_cells(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        (restitution, wall_restitution): (f64, f64),
+        width: f64,
+    ) -> Self {
         let n = circles.len();
         let size = arena.size();
-        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments);
+        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments, width);
         let mut engine = Self {
             arena: *arena,
             period: size,
@@ -203,9 +223,9 @@ impl EventEngine {
         self.stats
     }
 
-    /// Position of circle `i` now.
+    /// Position of circle `i` now (inside a periodic arena).
     pub fn position(&self, i: usize) -> DVec2 {
-        self.motion[i].at(self.now)
+        self.inside(self.motion[i].at(self.now))
     }
 
     /// Velocity of circle `i`.
@@ -280,10 +300,24 @@ impl EventEngine {
         self.predict_all();
     }
 
+    /// Moves circle `i`'s reference point to time `t`, where its course is about to change
+    /// (inside a periodic arena). Crossings never move it: only events that every grid of cells
+    /// shares do, so the trajectories do not depend on the grid.
     fn advance_circle(&mut self, i: usize, t: f64) {
-        let m = &mut self.motion[i];
-        m.pos = m.at(t);
-        m.t_at = t;
+        let p = self.motion[i].at(t);
+        self.motion[i].pos = self.inside(p);
+        self.motion[i].t_at = t;
+    }
+
+    /// `p`, or on a periodic arena its image in `[min, max)`.
+    #[inline]
+    fn inside(&self, p: DVec2) -> DVec2 {
+        let arena = &self.arena;
+        if self.grid.periodic && !(p.cmpge(arena.min).all() && p.cmplt(arena.max).all()) {
+            arena.wrap(p)
+        } else {
+            p
+        }
     }
 
     /// The displacement from `a` to `b` (minimum image on a periodic arena).
@@ -352,30 +386,20 @@ impl EventEngine {
         self.predict(j);
     }
 
+    /// Moves circle `i` into the next cell along `axis` (past a periodic edge, the first cell
+    /// on the other side). Its course is unchanged, so its motion is left as it is.
     fn cross_cell(&mut self, i: usize, axis: usize, up: bool) {
-        self.advance_circle(i, self.now);
         self.cells.remove(i, self.cell_index(i));
         let (count, cell) = if axis == 0 {
             (self.grid.cols as u32, &mut self.cell_x[i])
         } else {
             (self.grid.rows as u32, &mut self.cell_y[i])
         };
-        let mut wrapped = 0.0;
-        if up {
-            *cell += 1;
-            if *cell == count {
-                *cell = 0;
-                wrapped = -1.0;
-            }
-        } else if *cell == 0 {
-            *cell = count - 1;
-            wrapped = 1.0;
+        *cell = if up {
+            (*cell + 1) % count
         } else {
-            *cell -= 1;
-        }
-        if wrapped != 0.0 && self.grid.periodic {
-            self.motion[i].pos[axis] += wrapped * self.period[axis];
-        }
+            (*cell + count - 1) % count
+        };
         self.cells.insert(i, self.cell_index(i));
         self.predict_after_crossing(i, axis, up);
     }

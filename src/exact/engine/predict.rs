@@ -14,11 +14,14 @@ use crate::exact::toi::{pair_time_of_impact, segment_time_of_impact, wall_time_o
 use crate::grid::NONE;
 
 impl EventEngine {
-    /// The soonest collision of circle `i` with a circle in `cells`, as seen from now.
+    /// The soonest collision of circle `i` with a circle in `cells`, not before now.
+    ///
+    /// A pair's time is worked out from the later of its two last changes of course, not from
+    /// now, so it depends on the two motions alone: when the pair is looked at (after which
+    /// cell crossing) cannot change it, and the cell grid does not change the trajectories.
     fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
         let now = self.now;
         let me = self.motion[i];
-        let p = me.at(now);
         let mut best = NO_PAIR;
         for c in cells {
             for j in self.cells.members(c) {
@@ -26,13 +29,21 @@ impl EventEngine {
                     continue;
                 }
                 let other = &self.motion[j];
-                let dp = self.offset(p, other.at(now));
-                if let Some(t) =
-                    pair_time_of_impact(dp, other.vel - me.vel, me.radius + other.radius)
-                    && now + t < best.time
+                let since = me.t_at.max(other.t_at);
+                let dv = other.vel - me.vel;
+                let mut dp = other.at(since) - me.at(since);
+                if self.grid.periodic {
+                    // Through the image the pair is nearest in now: they may have flown far
+                    // since `since`.
+                    let d = dp + dv * (now - since);
+                    dp.x -= whole_periods(d.x, self.period.x);
+                    dp.y -= whole_periods(d.y, self.period.y);
+                }
+                if let Some(t) = pair_time_of_impact(dp, dv, me.radius + other.radius)
+                    && (since + t).max(now) < best.time
                 {
                     best = BestPair {
-                        time: now + t,
+                        time: (since + t).max(now),
                         partner: j as u32,
                         partner_count: self.counter[j],
                     };
@@ -86,10 +97,11 @@ impl EventEngine {
     }
 
     /// Sets circle `i`'s event to the soonest of its best pair, a wall hit, a hit on a segment
-    /// wall listed in its cell and a cell crossing.
+    /// wall listed in its cell and a cell crossing. Like pair times, these are worked out from
+    /// the circle's last change of course (`t_at`), never from now, and are never before now.
     fn schedule(&mut self, i: usize) {
         let m = self.motion[i];
-        let p = m.at(self.now);
+        let (p, since, now) = (m.pos, m.t_at, self.now);
         let best = self.best_pair[i];
         let (mut time, mut event) = (
             best.time,
@@ -104,6 +116,7 @@ impl EventEngine {
             },
         );
         let mut consider = |t: f64, kind: Kind, partner: u32| {
+            let t = (since + t).max(now);
             if t < time {
                 time = t;
                 event = Event {
@@ -116,7 +129,7 @@ impl EventEngine {
         for &k in self.segment_cells.in_cell(self.cell_index(i)) {
             let segment = &self.segments[k as usize];
             if let Some(t) = segment_time_of_impact(p, m.vel, m.radius, segment) {
-                consider(self.now + t, Kind::Segment, k);
+                consider(t, Kind::Segment, k);
             }
         }
         let walls = !self.grid.periodic;
@@ -131,24 +144,29 @@ impl EventEngine {
                 && let Some((t, _)) =
                     wall_time_of_impact(p[a], v, min[a] + m.radius, max[a] - m.radius)
             {
-                consider(self.now + t, Kind::Wall { axis }, NONE);
+                consider(t, Kind::Wall { axis }, NONE);
             }
-            // Cell crossing along this axis (none past the outer cells of a walled box).
+            // Cell crossing along this axis.
             let (cell, last) = if a == 0 {
                 (self.cell_x[i] as usize, self.grid.cols - 1)
             } else {
                 (self.cell_y[i] as usize, self.grid.rows - 1)
             };
             let up = v > 0.0;
-            if walls && ((up && cell == last) || (!up && cell == 0)) {
+            // None past the outer cells of a walled box, nor where one cell spans a period.
+            if (walls && ((up && cell == last) || (!up && cell == 0))) || last == 0 {
                 continue;
             }
-            let edge = self.grid.edge(a, cell + usize::from(up));
-            consider(
-                self.now + ((edge - p[a]) / v).max(0.0),
-                Kind::Cell { axis, up },
-                NONE,
-            );
+            let mut edge = self.grid.edge(a, cell + usize::from(up));
+            if !walls {
+                // The reference point is in the arena, the circle may have left it by whole
+                // periods since: the edge is the one in the circle's own image of the arena,
+                // found from where it is now (within half a cell of its cell, and with two
+                // cells or more a cell is at most half a period).
+                let middle = self.grid.edge(a, cell) + 0.5 * self.grid.cell[a];
+                edge += whole_periods(m.at(now)[a] - middle, self.period[a]);
+            }
+            consider((edge - p[a]) / v, Kind::Cell { axis, up }, NONE);
         }
         self.event[i] = event;
         self.queue.set(i, time);
@@ -158,5 +176,15 @@ impl EventEngine {
         for i in 0..self.len() {
             self.predict(i);
         }
+    }
+}
+
+/// The whole periods in `d` beyond its minimum image (`d` minus this is within half a period).
+#[inline]
+fn whole_periods(d: f64, period: f64) -> f64 {
+    if d.abs() > 0.5 * period {
+        period * (d / period).round()
+    } else {
+        0.0
     }
 }

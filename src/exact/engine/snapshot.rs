@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::events::{BestPair, Event, EventStats, Kind, Motion};
-use super::{EventEngine, walls_inside};
+use super::{EventEngine, cell_width, walls_inside};
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::exact::queue::EventQueue;
@@ -78,7 +78,8 @@ impl EventEngine {
             return Err(format!("engine clock {} is not finite", s.now));
         }
         let size = arena.size();
-        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments);
+        let width = cell_width(arena, circles);
+        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments, width);
         let partner_ok = |p: u32, i: usize| p == NONE || (p as usize) < n && p as usize != i;
         for (i, c) in circles.iter().enumerate() {
             let m = &s.motion[i];

@@ -3,6 +3,8 @@
 //! listed in the engine's cells.
 
 use super::EventEngine;
+use std::f64::consts::PI;
+
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::collide::contact::combine_restitution;
@@ -99,13 +101,14 @@ impl EventEngine {
     }
 }
 
-/// The engine's grid (cells at least one largest diameter wide, about four per circle or
-/// segment at most) and the segment walls it keeps, listed in the cells they pass within a
-/// largest radius of (none on a periodic arena).
+/// The engine's grid (cells at least `width` and one largest diameter wide, about four per
+/// circle or segment at most) and the segment walls it keeps, listed in the cells they pass
+/// within a largest radius of (none on a periodic arena).
 pub(super) fn walls_inside(
     arena: &Arena,
     circles: &[CircleState],
     segments: &[Segment],
+    width: f64,
 ) -> (Grid, Vec<Segment>, SegmentCells) {
     let segments = if arena.is_periodic() {
         &[][..]
@@ -117,7 +120,7 @@ pub(super) fn walls_inside(
     let grid = Grid::tiling(
         arena.min,
         arena.size(),
-        2.0 * largest,
+        width.max(2.0 * largest),
         cap,
         arena.is_periodic(),
     );
@@ -126,4 +129,115 @@ pub(super) fn walls_inside(
     let margin = largest + 1e-9 * grid.cell.max_element();
     let cells = SegmentCells::build(segments, grid, margin);
     (grid, segments.to_vec(), cells)
+}
+
+/// What a cell crossing costs (moving between cell lists, one more event in the queue) and what
+/// a collision's look at the 3×3 block of cells weighs, in pair predictions: fitted so that
+/// [`cell_width`] picks what measured fastest on a dilute gas (`p2000.txt`: about 1.6 mean
+/// spacings) and at area fraction 0.3 (about one diameter).
+const CROSSING_COST: f64 = 26.0;
+const COLLISION_WEIGHT: f64 = 60.0;
+
+/// The cell width that makes a circle's travel cheapest, before the largest diameter is taken
+/// into account. Per unit of path a circle crosses about `4 / (πL)` cells of width `L`, each
+/// crossing followed by a look into three new cells, and collides about `√2 ρ d g` times, each
+/// collision followed by a look into nine cells, with `ρ` circles per unit area of mean
+/// diameter `d` and `g` Henderson's contact value. With `L = u·s`, `s = 1/√ρ` the mean spacing,
+/// the cost is least where `CROSSING_COST / u² = 3 + COLLISION_WEIGHT · g · (d/s) · u`, solved
+/// here by bisection. Dense gases get cells about a diameter wide; dilute ones, cells a few
+/// spacings wide, so that a circle crosses fewer of them between collisions.
+pub(super) fn cell_width(arena: &Arena, circles: &[CircleState]) -> f64 {
+    let n = circles.len().max(1) as f64;
+    let size = arena.size();
+    let area = size.x * size.y;
+    let spacing = (area / n).sqrt();
+    let diameter = 2.0 * circles.iter().map(|c| c.radius).sum::<f64>() / n;
+    let fraction = circles.iter().map(|c| c.radius * c.radius).sum::<f64>() * PI / area;
+    let phi = fraction.min(0.8);
+    let contact = (1.0 - 7.0 * phi / 16.0) / ((1.0 - phi) * (1.0 - phi));
+    let collisions = COLLISION_WEIGHT * contact * diameter / spacing;
+    // Falls from +∞ near 0 to below 0 at √(CROSSING_COST / 3).
+    let excess = |u: f64| CROSSING_COST / (u * u) - 3.0 - collisions * u;
+    let (mut lo, mut hi) = (0.0, (CROSSING_COST / 3.0).sqrt());
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if excess(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // At least four cells a side, so that a pair in neighbouring cells is nearest through
+    // one image of a periodic arena.
+    (hi * spacing).min(0.25 * size.min_element())
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::math::DVec2;
+
+    use super::*;
+    use crate::arena::Boundary;
+
+    /// A gas of `n` circles of radius `r` on a jittered lattice, with pseudo-random velocities.
+    fn gas(n: usize, r: f64, arena: &Arena) -> Vec<CircleState> {
+        let side = (n as f64).sqrt().ceil() as usize;
+        let step = arena.size() / side as f64;
+        let mut x: u64 = 7;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        (0..n)
+            .map(|k| {
+                let cell = DVec2::new((k % side) as f64 + 0.5, (k / side) as f64 + 0.5);
+                let jitter = DVec2::new(next(), next()) * (step - 2.0 * r * DVec2::ONE) * 0.9;
+                let velocity = DVec2::new(next(), next());
+                CircleState::new(arena.min + cell * step + jitter, velocity, r)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_cells_do_not_change_the_trajectories() {
+        // Only collisions and wall hits move a circle's reference point, and every time is
+        // worked out from reference points: any grid gives the same run, bit for bit.
+        for boundary in [Boundary::Walls, Boundary::Periodic] {
+            let arena = Arena::unit_square(boundary);
+            let circles = gas(400, 0.01, &arena);
+            let run = |width: f64| {
+                let mut engine = EventEngine::with_cells(&circles, &arena, &[], (1.0, 1.0), width);
+                let cols = engine.grid.cols;
+                for step in 1..=20 {
+                    engine.advance_to(0.1 * step as f64, u64::MAX).unwrap();
+                }
+                let state: Vec<_> = (0..engine.len())
+                    .map(|i| (engine.position(i), engine.velocity(i)))
+                    .collect();
+                (cols, engine.stats().pair_collisions, state)
+            };
+            let (fine, coarse) = (run(0.0), run(0.2));
+            assert_eq!(
+                (fine.0, coarse.0),
+                (40, 5),
+                "{boundary:?}: the grids differ"
+            );
+            assert!(fine.1 > 1000, "{boundary:?}: only {} collisions", fine.1);
+            assert_eq!(fine.1, coarse.1, "{boundary:?}: collision counts");
+            assert!(fine.2 == coarse.2, "{boundary:?}: the states differ");
+        }
+    }
+
+    #[test]
+    fn dense_gases_get_cells_a_diameter_wide_dilute_ones_wider() {
+        let arena = Arena::unit_square(Boundary::Periodic);
+        let dense = gas(2500, 0.009, &arena); // area fraction 0.64
+        assert!(cell_width(&arena, &dense) < 2.0 * 0.009);
+        let dilute = gas(2000, 0.001, &arena); // 0.006, like p2000.txt
+        let spacing = (1.0f64 / 2000.0).sqrt();
+        let width = cell_width(&arena, &dilute);
+        assert!((1.2 * spacing..2.0 * spacing).contains(&width), "{width}");
+    }
 }
