@@ -19,6 +19,7 @@ pub mod grid;
 pub mod hits;
 pub mod integrate;
 pub mod io;
+pub mod lattice;
 pub mod range;
 #[cfg(feature = "render")]
 pub mod render;
@@ -49,7 +50,9 @@ pub mod prelude {
     pub use crate::circle::CircleState;
     pub use crate::collide::{CollidePlugin, PairCollisions};
     pub use crate::components::{Mass, Position, Radius, Restitution, Tint, Velocity};
-    pub use crate::config::{CirclesConfig, DropConfig, Effects, MassModel, Solver, SpawnConfig};
+    pub use crate::config::{
+        CirclesConfig, DropConfig, Effects, MassModel, Placement, Solver, SpawnConfig,
+    };
     pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin};
     pub use crate::effects::Effect;
     pub use crate::exact::ContinuousPlugin;

@@ -12,7 +12,7 @@ use moving_circles::arena::Boundary;
 use moving_circles::commands;
 use moving_circles::commands::run::MAX_THREADS;
 use moving_circles::commands::run::{Input, Length, RunOptions, SolverChoice};
-use moving_circles::config::{DT_RANGE, Solver};
+use moving_circles::config::{DT_RANGE, Placement, Solver};
 use moving_circles::io::printable;
 
 /// Moving, colliding circles. Without a subcommand, opens the app.
@@ -107,6 +107,13 @@ struct RunArgs {
     /// Seed of the random placement (overrides the scene).
     #[arg(long)]
     seed: Option<u64>,
+    /// Where a scene's circles are spawned: `random`, or `lattice` (a triangular lattice of
+    /// equal circles, for dense states up to area fraction ~0.88; overrides the scene).
+    #[arg(long)]
+    placement: Option<Placement>,
+    /// Fill this area fraction with a scene's circles (overrides the scene's count).
+    #[arg(long, value_name = "PHI")]
+    area_fraction: Option<f64>,
     /// Write the report (JSON) here.
     #[arg(long, value_name = "PATH.json")]
     report: Option<PathBuf>,
@@ -126,7 +133,7 @@ struct RunArgs {
     every: Option<u64>,
     /// Go on from a checkpoint, with its settings, for `--steps` / `--seconds` more; the result
     /// is bit for bit that of the run without the pause.
-    #[arg(long, value_name = "PATH", conflicts_with_all = ["solver", "dt", "seed", "boundary", "tolerance"])]
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["solver", "dt", "seed", "boundary", "tolerance", "placement", "area_fraction"])]
     resume: Option<PathBuf>,
 }
 
@@ -158,6 +165,10 @@ impl TryFrom<RunArgs> for RunOptions {
                 "--boundary applies to --particles files; a scene sets its own `arena.boundary`"
             ),
             (Some(scene), _) => Input::Scene(scene),
+            (None, Some(_)) if args.placement.is_some() || args.area_fraction.is_some() => bail!(
+                "--placement and --area-fraction spawn a scene's circles; a particle file lists \
+                 its own"
+            ),
             (None, Some(file)) => Input::Particles(file, args.boundary),
             (None, None) => match args.resume {
                 Some(checkpoint) => Input::Resume(checkpoint),
@@ -176,6 +187,8 @@ impl TryFrom<RunArgs> for RunOptions {
             dt: args.dt,
             length,
             seed: args.seed,
+            placement: args.placement,
+            area_fraction: args.area_fraction,
             report: args.report,
             dump: args.dump,
             threads: args.threads,

@@ -1,4 +1,4 @@
-//! Seeded, non-overlapping random placement of circles ([`place_circles`], a plain function over
+//! Seeded, non-overlapping placement of circles ([`place_circles`], a plain function over
 //! plain data) and [`SpawnPlugin`], which spawns them at startup and on [`Respawn`] requests,
 //! and drops circles in one at a time while the simulation runs ([`DropConfig`]).
 //!
@@ -17,9 +17,10 @@ use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::components::Position;
 use crate::components::Radius;
-use crate::config::{DropConfig, SpawnConfig};
+use crate::config::{DropConfig, Placement, SpawnConfig};
 use crate::error::FieldError;
 use crate::grid::{CellMembers, Grid};
+use crate::lattice::lattice_sites;
 use crate::schedule::CircleSystems;
 use crate::schedule::StepTotals;
 use crate::segment::{Segment, SegmentCells, Segments};
@@ -69,22 +70,40 @@ pub fn place_circles(
         grid.insert(circle.position, placed.len());
         placed.push(*circle);
     }
+    let mut sites = match config.placement {
+        Placement::Random => Vec::new(),
+        Placement::Lattice => {
+            // The check above made sure the lattice fits.
+            let sites = lattice_sites(arena.min, arena.size(), arena.is_periodic(), count, r_min)
+                .unwrap_or_default();
+            // `count` of the sites at random, kept in row order.
+            let mut chosen = rand::seq::index::sample(&mut rng, sites.len(), count).into_vec();
+            chosen.sort_unstable();
+            chosen.into_iter().map(|k| sites[k]).collect()
+        }
+    }
+    .into_iter();
     for r in radii {
         let lo = arena.min + DVec2::splat(r);
         let hi = arena.max - DVec2::splat(r);
         if lo.x > hi.x || lo.y > hi.y {
             continue; // larger than the arena
         }
-        let spot = (0..config.attempts_per_circle)
-            .map(|_| {
-                DVec2::new(
-                    sample_between(&mut rng, lo.x, hi.x),
-                    sample_between(&mut rng, lo.y, hi.y),
-                )
-            })
-            .find(|&p| {
-                !grid.overlaps_any(p, r, &placed) && walls.first_touched(segments, p, r).is_none()
-            });
+        let free = |p: &DVec2| {
+            !grid.overlaps_any(*p, r, &placed) && walls.first_touched(segments, *p, r).is_none()
+        };
+        let spot = match config.placement {
+            Placement::Random => (0..config.attempts_per_circle)
+                .map(|_| {
+                    DVec2::new(
+                        sample_between(&mut rng, lo.x, hi.x),
+                        sample_between(&mut rng, lo.y, hi.y),
+                    )
+                })
+                .find(free),
+            // A site a fixed circle or a segment wall takes is left empty.
+            Placement::Lattice => sites.next().filter(free),
+        };
         let Some(position) = spot else { continue };
         let speed = sample_between(&mut rng, s_min, s_max);
         let angle = rng.random_range(0.0..std::f64::consts::TAU);

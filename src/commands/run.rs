@@ -16,7 +16,7 @@ use crate::accuracy::auto::choose_solver;
 use crate::arena::Boundary;
 use crate::checkpoint::Checkpoint;
 use crate::circle::snapshot;
-use crate::config::{CirclesConfig, ParseSolverError, Solver};
+use crate::config::{CirclesConfig, ParseSolverError, Placement, Solver};
 use crate::io::{check_output_path, same_output, say, write_atomically};
 use crate::run::{Progress, Report, advance, default_sampling, headless_app, sample_end};
 use crate::scene::{Scene, particles};
@@ -90,6 +90,10 @@ pub struct RunOptions {
     pub length: Length,
     /// Overrides the placement seed.
     pub seed: Option<u64>,
+    /// Overrides where the scene's circles are spawned.
+    pub placement: Option<Placement>,
+    /// Overrides the scene's count with an area fraction to fill.
+    pub area_fraction: Option<f64>,
     /// Where the JSON report goes.
     pub report: Option<PathBuf>,
     /// Where the final state goes (particle format).
@@ -134,9 +138,11 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     let interrupts = Interrupts::install()?;
     let (mut app, mut progress, source, dt) = match &options.input {
         Input::Resume(path) => {
-            if options.solver.is_some() || options.dt.is_some() || options.seed.is_some() {
+            let spawn = options.placement.is_some() || options.area_fraction.is_some();
+            if options.solver.is_some() || options.dt.is_some() || options.seed.is_some() || spawn {
                 bail!(
-                    "--resume goes on with the checkpoint's settings: no --solver, --dt or --seed"
+                    "--resume goes on with the checkpoint's settings: no --solver, --dt, --seed, \
+                     --placement or --area-fraction"
                 );
             }
             let checkpoint = Checkpoint::read(path)?;
@@ -273,6 +279,12 @@ fn configure(input: &Input, options: &RunOptions) -> anyhow::Result<(CirclesConf
     }
     if let Some(seed) = options.seed {
         config.spawn.seed = seed;
+    }
+    if let Some(placement) = options.placement {
+        config.spawn.placement = placement;
+    }
+    if let Some(fraction) = options.area_fraction {
+        config.spawn.area_fraction = Some(fraction);
     }
     // The overrides go through the same check as the file did.
     config.check()?;

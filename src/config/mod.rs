@@ -17,9 +17,14 @@ pub use crate::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, che
 use crate::segment::Segments;
 pub use drop::DropConfig;
 pub use effects::Effects;
+pub use spawn::{
+    MAX_AREA_FRACTION, MAX_ATTEMPTS_PER_CIRCLE, MIN_RADIUS_FRACTION, MassModel, Placement,
+    SpawnConfig, min_radius,
+};
 
 mod drop;
 mod effects;
+mod spawn;
 
 /// Most circles any input may ask for: random spawns and particle files alike. Checked before
 /// anything is allocated, so a file claiming 10¹¹ circles fails at once; and small enough that
@@ -31,185 +36,6 @@ pub const MAX_CIRCLES: usize = 5_000_000;
 pub const DT_RANGE: (f64, f64) = (1e-9, 60.0);
 /// Most substeps `substeps=N` may ask for.
 pub const MAX_SUBSTEPS: u32 = 1024;
-/// Smallest radius, as a fraction of the arena's smaller side: below it the solvers' rounding
-/// of positions is the size of the circle, and ratios of radii overflow.
-pub const MIN_RADIUS_FRACTION: f64 = 1e-9;
-/// Most placement attempts per circle a spawn rule may ask for: beyond a few hundred, misses
-/// mean the arena is full, and more tries only make a full arena slower to give up on.
-pub const MAX_ATTEMPTS_PER_CIRCLE: u32 = 10_000;
-/// Densest area fraction random placement is asked for (0.907 is the densest packing of equal
-/// disks; placement by rejection stalls long before it).
-pub const MAX_AREA_FRACTION: f64 = 0.9;
-
-/// How a spawned circle's mass is chosen.
-#[derive(Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum MassModel {
-    /// Mass proportional to area: `density · π r²`.
-    Area {
-        /// Mass per unit area.
-        density: f64,
-    },
-    /// Every circle has this mass (the seed's assumption).
-    Equal(f64),
-}
-
-impl Default for MassModel {
-    fn default() -> Self {
-        Self::Area { density: 1.0 }
-    }
-}
-
-impl MassModel {
-    /// The mass of a circle of radius `r` under this model.
-    pub fn mass_of(self, r: f64) -> f64 {
-        match self {
-            Self::Area { density } => density * std::f64::consts::PI * r * r,
-            Self::Equal(m) => m,
-        }
-    }
-
-    /// Whether masses from this model are positive and finite.
-    pub fn check(self) -> Result<(), FieldError> {
-        match self {
-            Self::Area { density } => {
-                if density > 0.0 {
-                    check_magnitude("mass", density)
-                } else {
-                    Err(FieldError::new(
-                        "mass",
-                        format!("Area density must be positive, got {density:?}"),
-                    ))
-                }
-            }
-            Self::Equal(m) => check_mass("mass", m),
-        }
-    }
-}
-
-/// Random placement of circles: how many, how big, how fast. Seeded and reproducible.
-#[derive(Resource, Reflect, Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[reflect(Resource, Debug)]
-#[serde(default, deny_unknown_fields)]
-pub struct SpawnConfig {
-    /// How many circles to place (ignored when `area_fraction` is set).
-    pub count: usize,
-    /// Fill this fraction of the arena's area instead of placing `count` circles.
-    pub area_fraction: Option<f64>,
-    /// Smallest and largest radius; radii are drawn uniformly in between.
-    pub radius: (f64, f64),
-    /// Smallest and largest speed; directions are uniform.
-    pub speed: (f64, f64),
-    /// Seed of the random generator: the same seed gives the same circles.
-    pub seed: u64,
-    /// How masses are assigned.
-    pub mass: MassModel,
-    /// Placement attempts per circle before it is given up as not fitting.
-    pub attempts_per_circle: u32,
-}
-
-impl Default for SpawnConfig {
-    /// The seed exercise: 32 circles of random radius, speed and direction.
-    fn default() -> Self {
-        Self {
-            count: 32,
-            area_fraction: None,
-            radius: (0.2, 0.6),
-            speed: (1.0, 4.0),
-            seed: 1,
-            mass: MassModel::default(),
-            attempts_per_circle: 200,
-        }
-    }
-}
-
-impl SpawnConfig {
-    /// How many circles to place in `arena`: `count`, or as many as make up `area_fraction` of
-    /// its area on average (`E[r²] = (a² + ab + b²) / 3` for radii uniform in `[a, b]`).
-    pub fn target_count(&self, arena: &Arena) -> usize {
-        let Some(fraction) = self.area_fraction else {
-            return self.count;
-        };
-        let (a, b) = self.radius;
-        let mean_square = (a * a + a * b + b * b) / 3.0;
-        let n = fraction * arena.area() / (std::f64::consts::PI * mean_square);
-        // An overflowing estimate saturates to usize::MAX, which the count check refuses.
-        if n > 0.0 { n.round() as usize } else { 0 }
-    }
-
-    /// Whether these rules can place circles in `arena`: ranges ordered, finite and positive
-    /// where they must be, and no more than [`MAX_CIRCLES`] asked for. Fields are named
-    /// relative to the spawn rules (`radius`, `count`, …).
-    pub fn check(&self, arena: &Arena) -> Result<(), FieldError> {
-        let (r0, r1) = self.radius;
-        if !(r0.is_finite() && r1.is_finite() && r0 > 0.0 && r0 <= r1) {
-            return Err(FieldError::new(
-                "radius",
-                format!("must be (min, max) with 0 < min <= max, got ({r0}, {r1})"),
-            ));
-        }
-        let smallest = min_radius(arena);
-        if r0 < smallest {
-            return Err(FieldError::new(
-                "radius",
-                format!(
-                    "must be at least {MIN_RADIUS_FRACTION:?} of the arena's smaller side \
-                     ({smallest:?}), got ({r0:?}, {r1:?})"
-                ),
-            ));
-        }
-        check_magnitude("radius", r1)?;
-        for r in [r0, r1] {
-            check_mass("mass", self.mass.mass_of(r)).map_err(|e| {
-                FieldError::new(
-                    "mass",
-                    format!("gives a circle of radius {r:?} a mass that {}", e.message),
-                )
-            })?;
-        }
-        let (s0, s1) = self.speed;
-        check_magnitude("speed", s1)?;
-        if !(s0.is_finite() && s1.is_finite() && s0 >= 0.0 && s0 <= s1) {
-            return Err(FieldError::new(
-                "speed",
-                format!("must be (min, max) with 0 <= min <= max, got ({s0}, {s1})"),
-            ));
-        }
-        if let Some(phi) = self.area_fraction
-            && !(phi.is_finite() && phi > 0.0 && phi <= MAX_AREA_FRACTION)
-        {
-            return Err(FieldError::new(
-                "area_fraction",
-                format!(
-                    "must be in (0, {MAX_AREA_FRACTION}] (0.907 is the densest packing), got {phi}"
-                ),
-            ));
-        }
-        let n = self.target_count(arena);
-        if n > MAX_CIRCLES {
-            return Err(FieldError::new(
-                "count",
-                format!("asks for {n} circles; at most {MAX_CIRCLES} are supported"),
-            ));
-        }
-        if !(1..=MAX_ATTEMPTS_PER_CIRCLE).contains(&self.attempts_per_circle) {
-            return Err(FieldError::new(
-                "attempts_per_circle",
-                format!(
-                    "must be from 1 to {MAX_ATTEMPTS_PER_CIRCLE}, got {}",
-                    self.attempts_per_circle
-                ),
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// The smallest radius a circle in `arena` may have ([`MIN_RADIUS_FRACTION`] of its smaller
-/// side).
-pub fn min_radius(arena: &Arena) -> f64 {
-    MIN_RADIUS_FRACTION * arena.size().min_element()
-}
 
 /// How one fixed step of simulated time is advanced. Written in scenes and on the command line
 /// as `discrete`, `substeps=N`, `swept` or `exact`.
