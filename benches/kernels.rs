@@ -1,5 +1,6 @@
-//! Kernel benchmarks, no App: broad phase, one discrete contact pass, spawn placement, and the
-//! event engine's events per second (`exact`), on gases at area fraction 0.3.
+//! Kernel benchmarks, no App: broad phase, one discrete contact pass, spawn placement (random
+//! and lattice), and the event engine's events per second (`exact`), on gases at area fraction
+//! 0.3; and its pair collisions per second from dilute to dense (`exact_density`).
 //!
 //! `cargo bench --bench kernels`; set `MC_BENCH_LARGE=1` to add N = 1M.
 
@@ -86,6 +87,71 @@ fn spawn(c: &mut Criterion) {
     group.finish();
 }
 
+fn spawn_lattice(c: &mut Criterion) {
+    let mut group = c.benchmark_group("spawn_lattice");
+    group.sample_size(10);
+    for n in sizes() {
+        let config = lattice(n, 0.85);
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| black_box(place_circles(&config.arena, &config.spawn, &[], &[])))
+        });
+    }
+    group.finish();
+}
+
+/// `n` equal circles on a lattice at area fraction `fraction` in a periodic unit box.
+fn lattice(n: usize, fraction: f64) -> CirclesConfig {
+    let radius = (fraction / (n as f64 * std::f64::consts::PI)).sqrt();
+    CirclesConfig {
+        arena: Arena::unit_square(Boundary::Periodic),
+        spawn: SpawnConfig {
+            count: n,
+            radius: (radius, radius),
+            speed: (1.0, 1.0),
+            placement: Placement::Lattice,
+            ..SpawnConfig::default()
+        },
+        ..CirclesConfig::default()
+    }
+}
+
+/// Pair collisions per second of the event engine on 4096 equal circles in a periodic box,
+/// melted from a lattice (100 collisions per circle first), at area fractions from dilute to
+/// dense. Each iteration advances a fixed simulated time that holds about 20 000 collisions in
+/// the melted state; the throughput is the count measured over one such interval beforehand.
+fn exact_density(c: &mut Criterion) {
+    let mut group = c.benchmark_group("exact_density");
+    group.sample_size(10);
+    for fraction in [0.05, 0.3, 0.7] {
+        let config = lattice(4096, fraction);
+        let circles = place_circles(&config.arena, &config.spawn, &[], &[]).expect("fits");
+        let mut engine = EventEngine::new(&circles, &config.arena, &[], 1.0, 1.0);
+        let collisions = |engine: &EventEngine| engine.stats().pair_collisions;
+        // Melt, and find how long 20 000 collisions take.
+        let mut t = 0.0;
+        while collisions(&engine) < 100 * 4096 {
+            t += 0.01;
+            engine.advance_to(t, u64::MAX).expect("no budget");
+        }
+        let (start, before) = (engine.now(), collisions(&engine));
+        while collisions(&engine) - before < 20_000 {
+            t += 0.001;
+            engine.advance_to(t, u64::MAX).expect("no budget");
+        }
+        let interval = engine.now() - start;
+        let before = collisions(&engine);
+        engine
+            .advance_to(engine.now() + interval, u64::MAX)
+            .expect("no budget");
+        group.throughput(Throughput::Elements(collisions(&engine) - before));
+        group.bench_with_input(BenchmarkId::from_parameter(fraction), &fraction, |b, _| {
+            b.iter(|| black_box(engine.advance_to(engine.now() + interval, u64::MAX)))
+        });
+    }
+    group.finish();
+}
+
 fn exact_events(c: &mut Criterion) {
     let mut group = c.benchmark_group("exact_events");
     group.sample_size(10);
@@ -103,5 +169,13 @@ fn exact_events(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, broad_phase, contact_pass, spawn, exact_events);
+criterion_group!(
+    benches,
+    broad_phase,
+    contact_pass,
+    spawn,
+    spawn_lattice,
+    exact_events,
+    exact_density
+);
 criterion_main!(benches);

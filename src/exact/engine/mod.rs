@@ -224,11 +224,13 @@ impl EventEngine {
     }
 
     /// Position of circle `i` now (inside a periodic arena).
+    #[inline]
     pub fn position(&self, i: usize) -> DVec2 {
         self.inside(self.motion[i].at(self.now))
     }
 
     /// Velocity of circle `i`.
+    #[inline]
     pub fn velocity(&self, i: usize) -> DVec2 {
         self.motion[i].vel
     }

@@ -29,9 +29,13 @@ impl EventEngine {
                     continue;
                 }
                 let other = &self.motion[j];
-                let since = me.t_at.max(other.t_at);
+                // At the later reference time one of the two is at its reference point.
+                let (since, mut dp) = if me.t_at >= other.t_at {
+                    (me.t_at, other.at(me.t_at) - me.pos)
+                } else {
+                    (other.t_at, other.pos - me.at(other.t_at))
+                };
                 let dv = other.vel - me.vel;
-                let mut dp = other.at(since) - me.at(since);
                 if self.grid.periodic {
                     // Through the image the pair is nearest in now: they may have flown far
                     // since `since`.
