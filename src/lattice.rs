@@ -111,8 +111,9 @@ fn closest(a: f64, b: f64, cols: usize, rows: usize) -> f64 {
 fn best_shape(size: DVec2, periodic: bool, n: usize) -> (usize, usize) {
     // Equilateral: b = a·√3/2, so cols/rows = (W/a)/(H/b) = W·√3 / (2H).
     let ideal = (n as f64 * size.x * 3f64.sqrt() / (2.0 * size.y)).sqrt();
-    let low = ((ideal / 2.0).floor() as usize).max(1);
-    let high = ((ideal * 2.0).ceil() as usize).clamp(low, n);
+    // Within [1, n] whatever the arena's shape (a float past usize::MAX saturates).
+    let low = ((ideal / 2.0).floor() as usize).clamp(1, n.max(1));
+    let high = ((ideal * 2.0).ceil() as usize).clamp(low, n.max(1));
     let shape = |cols: usize| {
         let mut rows = n.div_ceil(cols);
         if periodic && rows % 2 == 1 {
@@ -178,6 +179,21 @@ mod tests {
                     };
                     assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{p} outside");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn arenas_of_any_shape_get_an_answer() {
+        for size in [
+            DVec2::new(1e12, 1.0),
+            DVec2::new(1.0, 1e12),
+            DVec2::new(1e300, 1e-300),
+        ] {
+            for periodic in [true, false] {
+                let fits = lattice_fits(size, periodic, 10, 1e-9);
+                let sites = lattice_sites(DVec2::ZERO, size, periodic, 10, 1e-9);
+                assert_eq!(fits.is_ok(), sites.is_ok(), "{size} {periodic}");
             }
         }
     }

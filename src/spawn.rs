@@ -77,7 +77,8 @@ pub fn place_circles(
             let sites = lattice_sites(arena.min, arena.size(), arena.is_periodic(), count, r_min)
                 .unwrap_or_default();
             // `count` of the sites at random, kept in row order.
-            let mut chosen = rand::seq::index::sample(&mut rng, sites.len(), count).into_vec();
+            let take = count.min(sites.len());
+            let mut chosen = rand::seq::index::sample(&mut rng, sites.len(), take).into_vec();
             chosen.sort_unstable();
             chosen.into_iter().map(|k| sites[k]).collect()
         }
