@@ -33,17 +33,15 @@ pub fn lattice_sites(
     if n == 0 {
         return Ok(Vec::new());
     }
-    lattice_fits(size, periodic, n, r)?;
-    let Some((corner, (a, b), (cols, rows))) = fit(size, periodic, n, r) else {
-        unreachable!("the lattice fits");
+    let Some(fit) = fit(size, periodic, n, r) else {
+        return Err(largest_radius(size, periodic, n, r));
     };
-    let mut sites = Vec::with_capacity(cols * rows);
-    for j in 0..rows {
+    let mut sites = Vec::with_capacity(fit.cols * fit.rows);
+    for j in 0..fit.rows {
         let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
-        for i in 0..cols {
-            let x = (i as f64 + 0.25 + shift) * a;
-            let y = (j as f64 + 0.5) * b;
-            sites.push(origin + corner + DVec2::new(x, y));
+        for i in 0..fit.cols {
+            let step = DVec2::new(i as f64 + 0.25 + shift, j as f64 + 0.5);
+            sites.push(origin + fit.corner + step * fit.spacing);
         }
     }
     Ok(sites)
@@ -53,10 +51,15 @@ pub fn lattice_sites(
 /// not, the largest radius it would fit (without making the sites).
 pub fn lattice_fits(size: DVec2, periodic: bool, n: usize, r: f64) -> Result<(), f64> {
     if n == 0 || fit(size, periodic, n, r).is_some() {
-        return Ok(());
+        Ok(())
+    } else {
+        Err(largest_radius(size, periodic, n, r))
     }
-    // With walls the room shrinks as the radius grows, so search for the largest radius that
-    // fits (fitting only gets harder with the radius).
+}
+
+/// The largest radius below `r` at which `n` circles fit. With walls the room shrinks as the
+/// radius grows, so it is searched for (fitting only gets harder with the radius).
+fn largest_radius(size: DVec2, periodic: bool, n: usize, r: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, r);
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
@@ -66,18 +69,20 @@ pub fn lattice_fits(size: DVec2, periodic: bool, n: usize, r: f64) -> Result<(),
             hi = mid;
         }
     }
-    Err(lo)
+    lo
 }
 
-/// The lattice for `n` circles of radius `r`, if it fits: its corner relative to the
-/// rectangle's, its spacings `(a, b)` and its shape `(cols, rows)`.
-#[allow(clippy::type_complexity)]
-fn fit(
-    size: DVec2,
-    periodic: bool,
-    n: usize,
-    r: f64,
-) -> Option<(DVec2, (f64, f64), (usize, usize))> {
+/// A lattice that fits: its corner relative to the rectangle's, its spacings (along a row,
+/// between rows) and its shape.
+struct Fit {
+    corner: DVec2,
+    spacing: DVec2,
+    cols: usize,
+    rows: usize,
+}
+
+/// The lattice for `n` circles of radius `r`, if it fits.
+fn fit(size: DVec2, periodic: bool, n: usize, r: f64) -> Option<Fit> {
     let (corner, room) = if periodic {
         (DVec2::ZERO, size)
     } else {
@@ -87,9 +92,14 @@ fn fit(
         return None;
     }
     let (cols, rows) = best_shape(room, periodic, n);
-    let (a, b) = (room.x / cols as f64, room.y / rows as f64);
+    let spacing = room / DVec2::new(cols as f64, rows as f64);
     // A hair of slack: sites exactly 2r apart touch, which the solvers accept.
-    (closest(a, b, cols, rows) >= 2.0 * r * (1.0 - 1e-12)).then_some((corner, (a, b), (cols, rows)))
+    (closest(spacing.x, spacing.y, cols, rows) >= 2.0 * r * (1.0 - 1e-12)).then_some(Fit {
+        corner,
+        spacing,
+        cols,
+        rows,
+    })
 }
 
 /// The distance between the closest sites of a lattice with spacing `a` along rows and `b`

@@ -225,15 +225,7 @@ impl SpawnConfig {
         }
         Ok(())
     }
-}
 
-/// The smallest radius a circle in `arena` may have ([`MIN_RADIUS_FRACTION`] of its smaller
-/// side).
-pub fn min_radius(arena: &Arena) -> f64 {
-    MIN_RADIUS_FRACTION * arena.size().min_element()
-}
-
-impl SpawnConfig {
     /// Whether a triangular lattice of `n` circles of radius `r` fits `arena`; if not, says how
     /// dense a lattice it takes.
     fn check_lattice(&self, arena: &Arena, n: usize, r: f64) -> Result<(), FieldError> {
@@ -252,4 +244,10 @@ impl SpawnConfig {
             )
         })
     }
+}
+
+/// The smallest radius a circle in `arena` may have ([`MIN_RADIUS_FRACTION`] of its smaller
+/// side).
+pub fn min_radius(arena: &Arena) -> f64 {
+    MIN_RADIUS_FRACTION * arena.size().min_element()
 }

@@ -11,9 +11,9 @@
 //! points, so the run does not depend on the cells. A [`Grid`] of cells at least one largest
 //! diameter wide and sized to the density ([`walls::cell_width`]), with memberships kept up to
 //! date by cell-crossing events, keeps prediction local. A crossing changes no trajectory, so it
-//! bumps no counter (events other circles hold with the crosser stay valid). Segment walls are listed in the
-//! cells they pass within a largest radius of ([`SegmentCells`]), so a circle looks only at its
-//! own cell's list, again after each crossing. Everything is f64.
+//! bumps no counter (events other circles hold with the crosser stay valid). Segment walls are
+//! listed in the cells they pass within a largest radius of ([`SegmentCells`]), so a circle
+//! looks only at its own cell's list, again after each crossing. Everything is f64.
 
 mod events;
 mod predict;

@@ -2,9 +2,9 @@
 //! inside it, at the point of the segment nearest the circle; and how the segment walls are
 //! listed in the engine's cells.
 
-use super::EventEngine;
 use std::f64::consts::PI;
 
+use super::EventEngine;
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::collide::contact::combine_restitution;
