@@ -1,12 +1,14 @@
 //! The accuracy study and `--solver auto`: the study writes its CSV (every solver present) and
-//! plot; tunnelling is told apart from bouncing; `auto` picks cheap solvers for loose
+//! its figure as SVG and PNG (every scene and measure); tunnelling is told apart from bouncing; `auto` picks cheap solvers for loose
 //! tolerances and an exact one for tight tolerances.
 
 use std::process::Command;
 
 use bevy::math::DVec2;
 use moving_circles::accuracy::auto::choose_solver;
+use moving_circles::accuracy::front::MEASURES;
 use moving_circles::accuracy::passed_through;
+use moving_circles::accuracy::plot::FIGURE_SIZE;
 use moving_circles::prelude::*;
 
 fn circle(x: f64, vx: f64) -> CircleState {
@@ -62,7 +64,7 @@ fn auto_picks_a_continuous_solver_for_a_tight_tolerance_and_a_cheap_one_for_a_lo
 }
 
 #[test]
-fn the_study_writes_a_csv_with_every_solver_and_a_plot() {
+fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
     let out = std::env::temp_dir().join(format!("mc-accuracy-{}", std::process::id()));
     let status = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -86,9 +88,31 @@ fn the_study_writes_a_csv_with_every_solver_and_a_plot() {
         }
     }
     let svg = std::fs::read_to_string(out.join("accuracy.svg")).unwrap();
+    assert!(svg.starts_with("<svg"), "not an SVG");
+    for scene in ["gas1k", "gas", "billiards", "fast"] {
+        for measure in &MEASURES {
+            assert!(
+                svg.contains(&format!("{scene} (n = ")) && svg.contains(measure.title),
+                "no panel for {scene}: {}",
+                measure.title
+            );
+        }
+    }
+    // The PNG is the same figure: its size, and drawn in the colours of the front and of the
+    // reference line (a blank or text-only image would fail).
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(out.join("accuracy.png")).unwrap(),
+    ));
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    assert_eq!((info.width, info.height), FIGURE_SIZE);
+    let count = |rgb: [u8; 3]| pixels.chunks(3).filter(|p| *p == rgb).count();
+    assert!(count([255, 200, 60]) > 1000, "no Pareto front drawn");
+    assert!(count([117, 80, 170]) > 1000, "no reference drawn");
     assert!(
-        svg.starts_with("<svg") && svg.contains("swept"),
-        "not a plot"
+        count([255, 255, 255]) > pixels.len() / 6,
+        "mostly not background"
     );
     std::fs::remove_dir_all(&out).unwrap();
 }

@@ -31,6 +31,9 @@ use crate::run::{Report, headless_app, run_steps};
 /// collisions per circle in the study's gases, before chaos makes every comparison meaningless.
 pub const HORIZON_SECONDS: f64 = 0.1;
 
+/// The reference's step: every run of a case is compared with `exact` at 60 Hz.
+pub const REFERENCE_DT: f64 = 1.0 / 60.0;
+
 /// The solvers the study compares, cheapest first by design (the measurement decides); the
 /// last, `exact`, is the reference.
 pub const SOLVERS: [Solver; 7] = [

@@ -4,17 +4,21 @@
 //!
 //! - [`measure`]: one run ([`trace`]) and its comparison with the reference ([`compare`]);
 //! - [`report`]: the rows as CSV and as a table;
-//! - [`plot`]: the figure;
+//! - [`front`]: the error measures the figure shows and the Pareto front of each;
+//! - [`plot`]: the figure, as SVG and PNG;
 //! - [`auto`]: `--solver auto`, the cheapest solver within a tolerance on the user's scene.
 
 pub mod auto;
+pub mod front;
 pub mod measure;
 pub mod plot;
 pub mod report;
 
 use std::path::Path;
 
-pub use measure::{Case, HORIZON_SECONDS, Row, SOLVERS, Trace, compare, passed_through, trace};
+pub use measure::{
+    Case, HORIZON_SECONDS, REFERENCE_DT, Row, SOLVERS, Trace, compare, passed_through, trace,
+};
 
 use crate::config::Solver;
 use crate::error::InputError;
@@ -55,7 +59,7 @@ pub fn default_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputE
 }
 
 /// Runs every case under every setting and compares each run with the case's `exact`
-/// reference at 60 Hz. `progress(case, setting)` is told what runs next (`None`: the
+/// reference at 60 Hz ([`REFERENCE_DT`]). `progress(case, setting)` is told what runs next (`None`: the
 /// reference).
 pub fn study(
     cases: &[Case],
@@ -65,7 +69,7 @@ pub fn study(
     let mut rows = Vec::new();
     for case in cases {
         progress(case, None);
-        let reference = trace(case, Solver::Exact, 1.0 / 60.0);
+        let reference = trace(case, Solver::Exact, REFERENCE_DT);
         for &(solver, dt) in settings {
             progress(case, Some((solver, dt)));
             rows.push(compare(case, &trace(case, solver, dt), &reference));

@@ -1,122 +1,341 @@
-//! The study's figure: per scene, position error against cost per step on log axes, one
-//! colour per solver, as SVG text.
+//! The study's figure, as SVG text ([`svg`]) and PNG bytes ([`png`]) from one drawing: a row
+//! of panels per scene, one panel per error measure ([`MEASURES`]), each plotting error
+//! against cost (ms per simulated second) on log axes. A line joins one solver's runs at 30, 60 and 120 Hz
+//! (marker shape gives the rate), the `exact` reference is a dashed vertical line at its cost
+//! (error 0 by definition), errors of exactly 0 sit on the axis's bottom line labelled `0`,
+//! and a grey band marks the Pareto front. The legend has a strip of its own above the panels.
 
+use std::sync::Once;
+
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
+use plotters::style::{FontStyle, register_font};
 
+use super::front::{MEASURES, Measure, Panel, cost, of_scene, rate, scenes};
 use super::measure::Row;
 
-/// Smallest error the plot shows: `exact` against itself is 0, and a log axis needs a floor.
-pub const PLOT_FLOOR: f64 = 1e-12;
+/// The figure's size in pixels (SVG user units and PNG pixels alike).
+pub const FIGURE_SIZE: (u32, u32) = (1600, 1290);
 
-/// A log-log plot per scene of position error against cost per step, as SVG text.
-pub fn plot(rows: &[Row]) -> Result<String, String> {
-    let mut svg = String::new();
-    draw(rows, &mut svg)?;
-    Ok(svg)
-}
+/// Height of the title and legend strip above the panels.
+const STRIP: u32 = 130;
 
-fn draw(rows: &[Row], svg: &mut String) -> Result<(), String> {
-    let scenes: Vec<&str> = rows.iter().fold(Vec::new(), |mut v, r| {
-        if !v.contains(&r.scene.as_str()) {
-            v.push(&r.scene);
-        }
-        v
-    });
-    let cols = 2usize;
-    let rows_of_panels = scenes.len().div_ceil(cols).max(1);
-    let root =
-        SVGBackend::with_string(svg, (1200, 460 * rows_of_panels as u32)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let panels = root.split_evenly((rows_of_panels, cols));
-    for (scene, panel) in scenes.iter().zip(panels.iter()) {
-        let mine: Vec<&Row> = rows.iter().filter(|r| r.scene == *scene).collect();
-        let x_range = log_range(mine.iter().map(|r| r.ms_per_step));
-        let y_range = log_range(mine.iter().map(|r| r.position_error.max(PLOT_FLOOR)));
-        let n = mine.first().map_or(0, |r| r.n);
-        let horizon = mine.first().map_or(0.0, |r| r.horizon);
-        let mut chart = ChartBuilder::on(panel)
-            .caption(
-                format!("{scene} (n = {n}), position error at t = {horizon} s"),
-                ("sans-serif", 20),
-            )
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .light_line_style(WHITE)
-            .x_label_formatter(&|v| format!("{v:.2}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .x_desc("ms per step")
-            .y_desc("position error vs exact (mean radii)")
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (family, colour) in FAMILIES {
-            let points: Vec<(f64, f64, String)> = mine
-                .iter()
-                .filter(|r| r.solver == family)
-                .map(|r| {
-                    (
-                        r.ms_per_step,
-                        r.position_error.max(PLOT_FLOOR),
-                        format!("{:.0}Hz", 1.0 / r.dt),
-                    )
-                })
-                .collect();
-            if points.is_empty() {
-                continue;
-            }
-            let colour = colour.to_rgba();
-            chart
-                .draw_series(
-                    points
-                        .iter()
-                        .map(|(x, y, _)| Circle::new((*x, *y), 5, colour.filled())),
-                )
-                .map_err(|e| e.to_string())?
-                .label(family)
-                .legend(move |(x, y)| Circle::new((x, y), 5, colour.filled()));
-            chart
-                .draw_series(points.iter().map(|(x, y, label)| {
-                    Text::new(
-                        label.clone(),
-                        (*x, *y),
-                        ("sans-serif", 11).into_font().color(&BLACK),
-                    )
-                }))
-                .map_err(|e| e.to_string())?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::MiddleRight)
-            .draw()
-            .map_err(|e| e.to_string())?;
-    }
-    root.present().map_err(|e| e.to_string())
-}
+/// The typeface for all text, embedded so the PNG needs no system fonts (DejaVu Sans; its
+/// licence is beside it in `assets/fonts`).
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-const FAMILIES: [(&str, plotters::style::RGBColor); 7] = [
-    ("discrete", plotters::style::RGBColor(220, 50, 47)),
-    ("substeps=2", plotters::style::RGBColor(203, 75, 22)),
-    ("substeps=4", plotters::style::RGBColor(181, 137, 0)),
-    ("substeps=8", plotters::style::RGBColor(133, 153, 0)),
-    ("substeps=16", plotters::style::RGBColor(42, 161, 152)),
-    ("swept", plotters::style::RGBColor(38, 139, 210)),
-    ("exact", plotters::style::RGBColor(108, 113, 196)),
+/// One colour per solver setting: a family shares a hue (substeps from light to dark).
+const SETTINGS: [(&str, RGBColor); 7] = [
+    ("discrete", RGBColor(215, 48, 39)),
+    ("substeps=2", RGBColor(161, 217, 155)),
+    ("substeps=4", RGBColor(94, 185, 100)),
+    ("substeps=8", RGBColor(35, 139, 69)),
+    ("substeps=16", RGBColor(0, 90, 50)),
+    ("swept", RGBColor(33, 113, 181)),
+    ("exact", RGBColor(117, 80, 170)),
 ];
 
-fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+const FRONT: RGBColor = RGBColor(255, 200, 60);
+const GRID: RGBColor = RGBColor(225, 225, 225);
+
+/// The figure as SVG text.
+pub fn svg(rows: &[Row]) -> Result<String, String> {
+    let mut text = String::new();
+    draw(
+        SVGBackend::with_string(&mut text, FIGURE_SIZE).into_drawing_area(),
+        rows,
+    )?;
+    Ok(text)
+}
+
+/// The figure as PNG bytes.
+pub fn png(rows: &[Row]) -> Result<Vec<u8>, String> {
+    let (width, height) = FIGURE_SIZE;
+    let mut rgb = vec![0u8; width as usize * height as usize * 3];
+    draw(
+        BitMapBackend::with_buffer(&mut rgb, FIGURE_SIZE).into_drawing_area(),
+        rows,
+    )?;
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// Draws the whole figure on `root`.
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, rows: &[Row]) -> Result<(), String> {
+    static FONTS: Once = Once::new();
+    FONTS.call_once(|| {
+        let parsed = register_font("sans-serif", FontStyle::Normal, FONT).is_ok();
+        assert!(parsed, "the embedded font parses");
+    });
+    root.fill(&WHITE).map_err(err)?;
+    let (strip, grid) = root.split_vertically(STRIP);
+    legend(&strip, rows)?;
+    let scenes = scenes(rows);
+    let panels = grid.split_evenly((scenes.len().max(1), MEASURES.len()));
+    for (s, scene) in scenes.iter().enumerate() {
+        let mine = of_scene(rows, scene);
+        for (m, measure) in MEASURES.iter().enumerate() {
+            panel(&panels[s * MEASURES.len() + m], &mine, measure)?;
+        }
+    }
+    root.present().map_err(err)
+}
+
+/// The title and the legend: settings, rates, the reference and the front.
+fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, rows: &[Row]) -> Result<(), String> {
+    let mut horizons: Vec<(f64, Vec<&str>)> = Vec::new();
+    for r in rows {
+        match horizons.iter_mut().find(|(h, _)| *h == r.horizon) {
+            Some((_, scenes)) if !scenes.contains(&r.scene.as_str()) => scenes.push(&r.scene),
+            Some(_) => {}
+            None => horizons.push((r.horizon, vec![&r.scene])),
+        }
+    }
+    let horizons: Vec<String> = horizons
+        .iter()
+        .map(|(h, scenes)| format!("{h} s ({})", scenes.join(", ")))
+        .collect();
+    let lines = [
+        "What accuracy costs: error against exact (y) vs CPU ms of stepping per simulated second (x), log axes; lower left is better."
+            .to_owned(),
+        format!(
+            "Position error is measured after {} (a few collisions per circle; later, chaos saturates it near one radius for every discrete solver). 0 on an axis: no error at all.",
+            horizons.join(" and ")
+        ),
+    ];
+    for (i, line) in lines.iter().enumerate() {
+        strip
+            .draw(&Text::new(line.as_str(), (14, 8 + 22 * i as i32), font(16)))
+            .map_err(err)?;
+    }
+    let row_y = 66;
+    let mut x = 14;
+    for (name, colour) in SETTINGS {
+        let y = row_y + 8;
+        strip
+            .draw(&PathElement::new(
+                vec![(x, y), (x + 28, y)],
+                colour.stroke_width(2),
+            ))
+            .map_err(err)?;
+        strip
+            .draw(&Circle::new((x + 14, y), 4, colour.filled()))
+            .map_err(err)?;
+        strip
+            .draw(&Text::new(name, (x + 34, row_y), font(14)))
+            .map_err(err)?;
+        x += 44 + 9 * name.len() as i32;
+    }
+    let y = row_y + 36;
+    let mut x = 14;
+    for hz in [30, 60, 120] {
+        marker(strip, hz, (x + 6, y), BLACK)?;
+        strip
+            .draw(&Text::new(format!("{hz} Hz"), (x + 16, y - 8), font(14)))
+            .map_err(err)?;
+        x += 80;
+    }
+    strip
+        .draw(&Rectangle::new(
+            [(x, y - 4), (x + 28, y + 4)],
+            FRONT.mix(0.6).filled(),
+        ))
+        .map_err(err)?;
+    strip
+        .draw(&Text::new(
+            "Pareto front: no cheaper setting is as accurate",
+            (x + 34, y - 8),
+            font(14),
+        ))
+        .map_err(err)?;
+    x += 400;
+    let exact = SETTINGS[6].1;
+    for k in 0..4 {
+        strip
+            .draw(&PathElement::new(
+                vec![(x + 4, y - 10 + 6 * k), (x + 4, y - 7 + 6 * k)],
+                exact.stroke_width(2),
+            ))
+            .map_err(err)?;
+    }
+    strip
+        .draw(&Text::new(
+            "exact at 60 Hz, the reference: its cost (its error is 0 by definition)",
+            (x + 14, y - 8),
+            font(14),
+        ))
+        .map_err(err)
+}
+
+/// One scene's panel for one measure.
+fn panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    rows: &[&Row],
+    measure: &Measure,
+) -> Result<(), String> {
+    let panel = Panel::new(rows, measure);
+    let front = panel.front();
+    let (reference, plotted) = (panel.reference, panel.points);
+    let scene = rows.first().map_or("", |r| r.scene.as_str());
+    let n = rows.first().map_or(0, |r| r.n);
+    let caption = format!("{scene} (n = {n}): {}", measure.title);
+    if plotted.is_empty() {
+        return area
+            .draw(&Text::new(
+                format!("{caption}: not measured"),
+                (20, 20),
+                font(14),
+            ))
+            .map_err(err);
+    }
+    let costs = rows.iter().map(|r| cost(r));
+    let (x_lo, x_hi) = decades(costs.clone().filter(|c| *c > 0.0)).unwrap_or((1e-3, 1.0));
+    let zero =
+        decades(plotted.iter().map(|p| p.1).filter(|e| *e > 0.0)).map_or(0.1, |(lo, _)| lo / 10.0);
+    let y_hi = decades(plotted.iter().map(|p| p.1).filter(|e| *e > 0.0))
+        .map_or(zero * 100.0, |(_, hi)| hi);
+    let y = |e: f64| if e > zero { e } else { zero };
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, font(14))
+        .margin(8)
+        .margin_right(16)
+        .x_label_area_size(34)
+        .y_label_area_size(50)
+        .build_cartesian_2d(
+            (x_lo..x_hi).log_scale().with_key_points(ticks(x_lo, x_hi)),
+            (zero..y_hi).log_scale().with_key_points(ticks(zero, y_hi)),
+        )
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .light_line_style(WHITE)
+        .bold_line_style(GRID)
+        .x_label_formatter(&|v| decade_label(*v, None))
+        .y_label_formatter(&|v| decade_label(*v, Some(zero)))
+        .label_style(font(12))
+        .axis_desc_style(font(12))
+        .x_desc("ms per simulated second")
+        .y_desc(measure.unit)
+        .draw()
+        .map_err(err)?;
+    // The front first, under the data: a step line through the settings no cheaper one beats,
+    // ending at the reference, and a halo on each.
+    let mut steps: Vec<(f64, f64)> = Vec::new();
+    for p in &front {
+        if let Some(&(_, previous)) = steps.last() {
+            steps.push((p.cost, previous));
+        }
+        steps.push((p.cost, y(p.error)));
+    }
+    chart
+        .draw_series(LineSeries::new(steps, FRONT.mix(0.6).stroke_width(9)))
+        .map_err(err)?;
+    chart
+        .draw_series(
+            front
+                .iter()
+                .map(|p| Circle::new((p.cost, y(p.error)), 10, FRONT.filled())),
+        )
+        .map_err(err)?;
+    if let Some(reference) = reference {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(cost(reference), zero), (cost(reference), y_hi)],
+                4,
+                4,
+                SETTINGS[6].1.stroke_width(2),
+            ))
+            .map_err(err)?;
+    }
+    for (name, colour) in SETTINGS {
+        let mut line: Vec<(&Row, f64)> = plotted
+            .iter()
+            .filter(|(r, _)| r.solver == name)
+            .copied()
+            .collect();
+        line.sort_by(|a, b| a.0.dt.total_cmp(&b.0.dt).reverse());
+        chart
+            .draw_series(LineSeries::new(
+                line.iter().map(|(r, e)| (cost(r), y(*e))),
+                colour.stroke_width(2),
+            ))
+            .map_err(err)?;
+        for (r, e) in line {
+            marker(chart.plotting_area(), rate(r), (cost(r), y(e)), colour)?;
+        }
+    }
+    Ok(())
+}
+
+/// Draws the marker for a rate at `at`: a triangle for 30 Hz, a circle for 60 Hz, a square
+/// for 120 Hz (and a cross for any other).
+fn marker<DB: DrawingBackend, CT: CoordTranslate>(
+    area: &DrawingArea<DB, CT>,
+    hz: u32,
+    at: CT::From,
+    colour: RGBColor,
+) -> Result<(), String> {
+    let style = colour.filled();
+    let at = EmptyElement::at(at);
+    match hz {
+        30 => area.draw(&(at + TriangleMarker::new((0, 0), 6, style))),
+        60 => area.draw(&(at + Circle::new((0, 0), 5, style))),
+        120 => area.draw(&(at + Rectangle::new([(-4, -4), (4, 4)], style))),
+        _ => area.draw(&(at + Cross::new((0, 0), 5, colour.stroke_width(2)))),
+    }
+    .map_err(err)
+}
+
+/// The whole decades around the positive `values`: `(10^floor(log min), 10^ceil(log max))`,
+/// at least one decade apart; `None` when there are none.
+fn decades(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         });
     if lo > hi {
-        return 1e-3..1.0;
+        return None;
     }
-    (lo / 2.0)..(hi * 2.0)
+    let lo = lo.log10().floor();
+    let hi = hi.log10().ceil().max(lo + 1.0);
+    Some((10f64.powf(lo), 10f64.powf(hi)))
+}
+
+/// Ticks at whole decades from `lo` to `hi` (both decades), every decade or every few so there
+/// are at most seven, always including `lo`.
+fn ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (lo, hi) = (lo.log10().round() as i32, hi.log10().round() as i32);
+    let step = ((hi - lo) as usize).div_ceil(6).max(1);
+    (lo..=hi).step_by(step).map(|k| 10f64.powi(k)).collect()
+}
+
+/// A tick label: decades only (`0.01`, `1`, `100`, `1e-6`), `0` at the zero line, nothing in
+/// between, so labels never run together.
+fn decade_label(v: f64, zero: Option<f64>) -> String {
+    if zero.is_some_and(|z| (v / z - 1.0).abs() < 1e-6) {
+        return "0".into();
+    }
+    let e = v.log10();
+    if (e - e.round()).abs() > 1e-6 {
+        return String::new();
+    }
+    match e.round() as i32 {
+        k @ -2..=3 => format!("{}", 10f64.powi(k)),
+        k => format!("1e{k}"),
+    }
+}
+
+fn font(size: u32) -> TextStyle<'static> {
+    ("sans-serif", size).into_font().color(&BLACK)
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
 }

@@ -1,6 +1,8 @@
 //! The study's results as text: a CSV with one column per [`Row`] field (written through
-//! serde, so the columns are the struct's) and the fixed-width table the command prints.
+//! serde, so the columns are the struct's), the fixed-width table the command prints, and the
+//! Pareto fronts as text.
 
+use super::front::{MEASURES, Panel, of_scene, scenes};
 use super::measure::Row;
 
 /// The study as CSV text, a header line then one line per row.
@@ -46,6 +48,31 @@ pub fn to_table(rows: &[Row]) -> String {
             r.collision_error,
             r.z_error.map(|z| format!("{z:+.3}")).unwrap_or_else(|| "-".into()),
         ));
+    }
+    out
+}
+
+/// Each scene's Pareto front per measure, one line each: the settings, cheapest first, that
+/// are more accurate than every cheaper one, ending at the reference. What to pick for an
+/// error budget is the first setting within it.
+pub fn to_fronts(rows: &[Row]) -> String {
+    let mut out = String::from(
+        "Pareto fronts (cheapest first; ms of stepping per simulated second, then the error):\n",
+    );
+    for scene in scenes(rows) {
+        let mine = of_scene(rows, scene);
+        for measure in &MEASURES {
+            let front: Vec<String> = Panel::new(&mine, measure)
+                .front()
+                .iter()
+                .map(|p| format!("{} {:.3} ms ({:.2e})", p.label, p.cost, p.error))
+                .collect();
+            out.push_str(&format!(
+                "{scene:<9} {:<27} {}\n",
+                measure.title,
+                front.join(" > ")
+            ));
+        }
     }
     out
 }

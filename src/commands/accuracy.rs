@@ -1,12 +1,12 @@
 //! `moving_circles accuracy`: run the accuracy study with a progress bar, print its table and
-//! write `accuracy.csv` and `accuracy.svg`.
+//! write `accuracy.csv` with the figure as `accuracy.svg` and `accuracy.png`.
 
 use std::path::Path;
 
 use anyhow::Context;
 
-use crate::accuracy::plot::plot;
-use crate::accuracy::report::{to_csv, to_table};
+use crate::accuracy::plot::{png, svg};
+use crate::accuracy::report::{to_csv, to_fronts, to_table};
 use crate::accuracy::{default_cases, settings, study};
 use crate::io::{say, write_atomically};
 
@@ -30,19 +30,24 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
         });
     });
     bar.finish_and_clear();
-    say(to_table(&rows).trim_end());
+    to_table(&rows).lines().for_each(say);
+    to_fronts(&rows).lines().for_each(say);
     let csv = out.join("accuracy.csv");
     let text = to_csv(&rows).context("formatting the CSV")?;
     write_atomically(&csv, text.as_bytes())
         .with_context(|| format!("writing {}", csv.display()))?;
-    let svg = out.join("accuracy.svg");
-    let drawing = plot(&rows).map_err(|e| anyhow::anyhow!("drawing {}: {e}", svg.display()))?;
-    write_atomically(&svg, drawing.as_bytes())
-        .with_context(|| format!("writing {}", svg.display()))?;
+    let figure = out.join("accuracy.svg");
+    let drawing = svg(&rows).map_err(|e| anyhow::anyhow!("drawing {}: {e}", figure.display()))?;
+    write_atomically(&figure, drawing.as_bytes())
+        .with_context(|| format!("writing {}", figure.display()))?;
+    let picture = out.join("accuracy.png");
+    let bytes = png(&rows).map_err(|e| anyhow::anyhow!("drawing {}: {e}", picture.display()))?;
+    write_atomically(&picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
     say(format_args!(
-        "wrote {} and {}",
+        "wrote {}, {} and {}",
         csv.display(),
-        svg.display()
+        figure.display(),
+        picture.display()
     ));
     Ok(())
 }
