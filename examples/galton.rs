@@ -35,6 +35,7 @@ fn main() -> AppExit {
         AppOptions {
             scene_file: None,
             screenshot: options.screenshot,
+            panel: false,
         },
     );
     if let Some(k) = options.steps_per_frame {

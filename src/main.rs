@@ -72,6 +72,9 @@ struct AppArgs {
     /// Frames to render before `--screenshot` is taken.
     #[arg(long, default_value_t = 90, requires = "screenshot")]
     frames: u32,
+    /// Open with the live panel shown (`p` shows and hides it).
+    #[arg(long)]
+    panel: bool,
 }
 
 #[derive(Args, Debug)]
@@ -227,6 +230,7 @@ fn open_app(args: AppArgs) -> anyhow::Result<()> {
         seed: args.seed,
         solver: args.solver,
         screenshot: args.screenshot.map(|path| (path, args.frames)),
+        panel: args.panel,
     };
     if !commands::app::open(options)? {
         bail!("the app ended with an error");

@@ -22,6 +22,8 @@ pub struct AppOptions {
     pub solver: Option<Solver>,
     /// Render this many frames, save a PNG there and exit.
     pub screenshot: Option<(PathBuf, u32)>,
+    /// Whether the live panel starts shown.
+    pub panel: bool,
 }
 
 /// The configuration the app opens on.
@@ -72,6 +74,7 @@ pub fn open(options: AppOptions) -> anyhow::Result<bool> {
     let options = render::AppOptions {
         scene_file: options.scene,
         screenshot: options.screenshot,
+        panel: options.panel,
     };
     Ok(render::app(config, options).run().is_success())
 }

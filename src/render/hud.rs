@@ -61,6 +61,7 @@ space     pause / resume
 1 2 3 4   solver: discrete / substeps=8 / swept / exact
 mouse     drag a circle to fling it
 h         this help
+p         live panel: plots, sliders, compare
 q, Esc    quit";
 
 fn spawn_hud(mut commands: Commands) {

@@ -32,7 +32,7 @@ impl Plugin for InputPlugin {
 }
 
 /// Largest count `+` goes to: beyond this the app stops being interactive on a laptop.
-const MAX_COUNT: usize = 1 << 20;
+pub const MAX_COUNT: usize = 1 << 20;
 /// Slowest and fastest relative speed of simulated time.
 const SPEED_RANGE: (f32, f32) = (1.0 / 64.0, 16.0);
 

@@ -1,11 +1,13 @@
 //! The windowed app's side (cargo feature `render`): a camera that keeps the whole arena in view
 //! at its aspect ratio, one sprite per circle sharing a single disc texture (so thousands draw
 //! in a handful of batched draw calls, each with its own tint), a thin bar per segment wall, and
-//! the [`hud`], [`input`] and [`screenshot`] plugins. The simulation never reads anything from here: `Position` is copied
-//! into `Transform` once per frame, after the fixed steps.
+//! the [`hud`], [`input`] and [`screenshot`] plugins; the app adds the live [`panel`]. The
+//! simulation never reads anything from here: `Position` is copied into `Transform` once per
+//! frame, after the fixed steps.
 
 pub mod hud;
 pub mod input;
+pub mod panel;
 pub mod screenshot;
 
 use bevy::asset::RenderAssetUsages;
@@ -222,6 +224,8 @@ pub struct AppOptions {
     pub scene_file: Option<std::path::PathBuf>,
     /// Render this many frames, save a PNG there and exit.
     pub screenshot: Option<(std::path::PathBuf, u32)>,
+    /// Whether the live panel starts shown.
+    pub panel: bool,
 }
 
 /// The complete windowed app: Bevy's default plugins (as far as the enabled features go), the
@@ -236,6 +240,8 @@ pub fn app(config: crate::config::CirclesConfig, options: AppOptions) -> App {
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
             .unwrap_or(std::path::Path::new("."));
+        // Absolute, since Bevy reads a relative asset folder from beside the executable.
+        let dir = std::path::absolute(dir).ok()?;
         let name = path.file_name()?.to_string_lossy().into_owned();
         app.register_asset_source(
             "scene",
@@ -259,6 +265,9 @@ pub fn app(config: crate::config::CirclesConfig, options: AppOptions) -> App {
             }),
         crate::CirclesPlugins::new(config),
         CirclesRenderPlugin,
+        panel::PanelPlugin {
+            open: options.panel,
+        },
     ));
     if let Some(asset_path) = watched {
         app.add_plugins(crate::scene::asset::SceneReloadPlugin { asset_path });

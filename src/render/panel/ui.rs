@@ -1,0 +1,297 @@
+//! The panel's egui window, docked at the top right: solver buttons; sliders and toggles for
+//! the circle count, restitution, gravity, drag, step rate and speed; a rolling plot per
+//! measure with one colour per solver; and the comparison's button and table. It only reads
+//! resources and writes [`Control`] messages.
+
+use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_egui::{EguiContexts, egui};
+use egui_plot::{Legend, Line, Plot};
+
+use super::PanelOpen;
+use super::compare::{COMPARE_SECONDS, Comparison};
+use super::controls::{Control, SPEED_RANGE};
+use super::live::{LiveHistory, LiveSample};
+use crate::accuracy::Row;
+use crate::config::{Effects, Solver};
+use crate::diagnostics::CircleDiagnostics;
+use crate::render::input::MAX_COUNT;
+
+/// Slider values being dragged: a change that respawns is sent when the drag ends.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct Drafts {
+    count: Option<usize>,
+}
+
+/// The settings the panel shows and changes.
+#[derive(SystemParam)]
+pub struct Settings<'w> {
+    solver: Res<'w, Solver>,
+    effects: Res<'w, Effects>,
+    diagnostics: Res<'w, CircleDiagnostics>,
+    fixed: Res<'w, Time<Fixed>>,
+    virt: Res<'w, Time<Virtual>>,
+}
+
+/// The solvers the panel offers, with the colour each has in plots (as in the accuracy
+/// figure).
+const SOLVERS: [(Solver, [u8; 3]); 4] = [
+    (Solver::Discrete, [215, 48, 39]),
+    (Solver::Substeps(8), [35, 139, 69]),
+    (Solver::Swept, [33, 113, 181]),
+    (Solver::Exact, [160, 120, 230]),
+];
+
+/// Draws the panel when it is shown.
+pub fn draw_panel(
+    mut contexts: EguiContexts,
+    open: Res<PanelOpen>,
+    history: Res<LiveHistory>,
+    comparison: Res<Comparison>,
+    settings: Settings,
+    mut drafts: ResMut<Drafts>,
+    mut controls: MessageWriter<Control>,
+) -> Result {
+    if !open.0 {
+        return Ok(());
+    }
+    let ctx = contexts.ctx_mut()?;
+    let mut sent = Vec::new();
+    egui::Window::new("moving circles  (p: hide)")
+        .anchor(egui::Align2::RIGHT_TOP, [-6.0, 6.0])
+        .default_width(330.0)
+        .resizable(false)
+        .collapsible(false)
+        .show(ctx, |ui| {
+            let height = ui.ctx().content_rect().height() - 60.0;
+            egui::ScrollArea::vertical()
+                .max_height(height)
+                .min_scrolled_height(height)
+                .show(ui, |ui| {
+                    solver_buttons(ui, *settings.solver, &mut sent);
+                    ui.separator();
+                    sliders(ui, &settings, &mut drafts, &mut sent);
+                    ui.separator();
+                    plots(ui, &history);
+                    ui.separator();
+                    comparison_section(ui, &comparison, &mut sent);
+                });
+        });
+    controls.write_batch(sent);
+    Ok(())
+}
+
+fn solver_buttons(ui: &mut egui::Ui, current: Solver, sent: &mut Vec<Control>) {
+    ui.horizontal(|ui| {
+        ui.label("solver");
+        for (solver, _) in SOLVERS {
+            if ui
+                .selectable_label(current == solver, solver.to_string())
+                .clicked()
+                && current != solver
+            {
+                sent.push(Control::Solver(solver));
+            }
+        }
+    });
+}
+
+fn sliders(ui: &mut egui::Ui, settings: &Settings, drafts: &mut Drafts, sent: &mut Vec<Control>) {
+    let now = settings.diagnostics.count;
+    let mut count = drafts.count.unwrap_or(now);
+    let response = ui.add(
+        egui::Slider::new(&mut count, 1..=MAX_COUNT)
+            .logarithmic(true)
+            .text("circles (respawns)"),
+    );
+    if response.dragged() {
+        drafts.count = Some(count);
+    }
+    if (response.drag_stopped() || (response.changed() && !response.dragged())) && count != now {
+        sent.push(Control::Count(count));
+        drafts.count = None;
+    }
+
+    let effects = *settings.effects;
+    let mut restitution = effects.restitution;
+    if ui
+        .add(egui::Slider::new(&mut restitution, 0.0..=1.0).text("restitution"))
+        .changed()
+    {
+        sent.push(Control::Restitution(restitution));
+    }
+
+    let gravity = effects.gravity.unwrap_or(DVec2::new(0.0, -9.81));
+    let (mut on, mut g) = (effects.gravity.is_some(), gravity.length());
+    ui.horizontal(|ui| {
+        let toggled = ui.checkbox(&mut on, "gravity").changed();
+        let moved = ui
+            .add_enabled(on, egui::Slider::new(&mut g, 0.0..=50.0).suffix(" m/s²"))
+            .changed();
+        if toggled || moved {
+            let direction = gravity.try_normalize().unwrap_or(DVec2::NEG_Y);
+            sent.push(Control::Gravity(on.then_some(direction * g)));
+        }
+    });
+
+    let (mut on, mut rate) = (effects.drag.is_some(), effects.drag.unwrap_or(0.5));
+    ui.horizontal(|ui| {
+        let toggled = ui.checkbox(&mut on, "drag").changed();
+        let moved = ui
+            .add_enabled(on, egui::Slider::new(&mut rate, 0.0..=10.0).suffix(" /s"))
+            .changed();
+        if toggled || moved {
+            sent.push(Control::Drag(on.then_some(rate)));
+        }
+    });
+
+    let mut hz = (1.0 / settings.fixed.timestep().as_secs_f64()).round();
+    if ui
+        .add(
+            egui::Slider::new(&mut hz, 15.0..=480.0)
+                .logarithmic(true)
+                .integer()
+                .text("steps per simulated s"),
+        )
+        .changed()
+    {
+        sent.push(Control::Dt(1.0 / hz));
+    }
+
+    let mut speed = settings.virt.relative_speed_f64();
+    if ui
+        .add(
+            egui::Slider::new(&mut speed, SPEED_RANGE.0..=SPEED_RANGE.1)
+                .logarithmic(true)
+                .text("speed (simulated s per s)"),
+        )
+        .changed()
+    {
+        sent.push(Control::Speed(speed));
+    }
+}
+
+/// The rolling plots: one per measure, a line per solver (broken where another solver ran).
+fn plots(ui: &mut egui::Ui, history: &LiveHistory) {
+    type Measure = (&'static str, fn(&LiveSample) -> Option<f64>);
+    let measures: [Measure; 5] = [
+        ("ms per step", |s| s.ms_per_step),
+        ("collisions per simulated s", |s| s.collisions_per_second),
+        ("deepest overlap (radii)", |s| Some(s.overlap)),
+        ("pressure z", |s| s.z),
+        ("energy drift", |s| Some(s.energy_drift)),
+    ];
+    for (k, (title, value)) in measures.into_iter().enumerate() {
+        ui.label(title);
+        let mut plot = Plot::new(title)
+            .height(48.0)
+            .allow_zoom(false)
+            .allow_drag(false)
+            .allow_scroll(false)
+            .allow_boxed_zoom(false)
+            .allow_double_click_reset(false)
+            .show_axes([false, true])
+            .y_axis_formatter(|mark, _| tick(mark.value));
+        if k == 0 {
+            plot = plot.legend(Legend::default());
+        }
+        plot.show(ui, |plot| {
+            for (solver, colour, points) in runs(history, value) {
+                let [r, g, b] = colour;
+                plot.line(
+                    Line::new(solver.to_string(), points)
+                        .color(egui::Color32::from_rgb(r, g, b))
+                        .width(2.0),
+                );
+            }
+        });
+    }
+}
+
+/// The samples as runs of one solver each: `(solver, colour, points)`.
+fn runs(
+    history: &LiveHistory,
+    value: fn(&LiveSample) -> Option<f64>,
+) -> Vec<(Solver, [u8; 3], Vec<[f64; 2]>)> {
+    let mut runs: Vec<(Solver, [u8; 3], Vec<[f64; 2]>)> = Vec::new();
+    for sample in &history.samples {
+        let Some(y) = value(sample).filter(|y| y.is_finite()) else {
+            continue;
+        };
+        match runs.last_mut() {
+            Some((solver, _, points)) if *solver == sample.solver => points.push([sample.t, y]),
+            _ => runs.push((sample.solver, colour(sample.solver), vec![[sample.t, y]])),
+        }
+    }
+    runs
+}
+
+/// A compact axis label: `1.5e-14`, `0.25`, `7000`.
+fn tick(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-2 || v.abs() >= 1e5) {
+        format!("{v:.0e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+fn colour(solver: Solver) -> [u8; 3] {
+    SOLVERS
+        .iter()
+        .find(|(s, _)| std::mem::discriminant(s) == std::mem::discriminant(&solver))
+        .map_or([200, 200, 200], |(_, c)| *c)
+}
+
+fn comparison_section(ui: &mut egui::Ui, comparison: &Comparison, sent: &mut Vec<Control>) {
+    let running = comparison.is_running();
+    let label = format!("compare every solver ({COMPARE_SECONDS} s from now)");
+    if ui.add_enabled(!running, egui::Button::new(label)).clicked() {
+        sent.push(Control::Compare);
+    }
+    match comparison {
+        Comparison::Idle => {}
+        Comparison::Running { done, from, .. } => {
+            let done = done.load(std::sync::atomic::Ordering::Relaxed);
+            ui.label(format!(
+                "running in the background from {from}: {done} of {} runs",
+                Comparison::RUNS
+            ));
+        }
+        Comparison::Failed(why) => {
+            ui.colored_label(egui::Color32::LIGHT_RED, why);
+        }
+        Comparison::Done { from, rows } => {
+            ui.label(format!("from {from}, against exact:"));
+            comparison_table(ui, rows);
+        }
+    }
+}
+
+fn comparison_table(ui: &mut egui::Ui, rows: &[Row]) {
+    egui::Grid::new("comparison").striped(true).show(ui, |ui| {
+        for head in [
+            "solver",
+            "ms/step",
+            "collisions",
+            "z",
+            "overlap",
+            "tunnelled",
+        ] {
+            ui.strong(head);
+        }
+        ui.end_row();
+        for row in rows {
+            ui.label(&row.solver);
+            ui.label(format!("{:.3}", row.ms_per_step));
+            ui.label(format!("{:+.1} %", 100.0 * row.collision_error));
+            ui.label(
+                row.z_error
+                    .map_or("-".into(), |z| format!("{:+.1} %", 100.0 * z)),
+            );
+            ui.label(format!("{:.2}", row.max_penetration));
+            ui.label(row.tunnelled.to_string());
+            ui.end_row();
+        }
+    });
+}
