@@ -215,6 +215,17 @@ pub fn printable(text: &str) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
+/// `rows` as CSV text, a header line then one line per row, the columns being the fields
+/// (through serde).
+pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String, csv::Error> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    for row in rows {
+        writer.serialize(row)?;
+    }
+    let bytes = writer.into_inner().map_err(|e| e.into_error())?;
+    Ok(String::from_utf8(bytes).expect("csv writes the UTF-8 it is given"))
+}
+
 /// Writes a line to stdout. A closed pipe (`moving_circles run … | head -1`) ends the reader's
 /// interest, not the work: the files asked for are still written, so a failed write to stdout
 /// is ignored instead of panicking as `println!` does.

@@ -30,9 +30,9 @@ enum Command {
     /// Run a scene or particle file headless and report (no window).
     Run(Box<RunArgs>),
     /// Run the accuracy study: every solver and step on a set of scenes, measured against
-    /// `exact`; prints a table and writes accuracy.csv and accuracy.svg.
+    /// `exact`; prints a table and writes accuracy.csv and the figure (accuracy.svg and .png).
     Accuracy {
-        /// Folder for accuracy.csv and accuracy.svg.
+        /// Folder for accuracy.csv, accuracy.svg and accuracy.png.
         #[arg(long, value_name = "DIR", default_value = "out")]
         out: PathBuf,
         /// Folder the study's scenes (gas1k, gas, billiards, fast) are read from.
@@ -41,6 +41,33 @@ enum Command {
         /// One step size and shorter runs: a smoke test of the study, not a measurement.
         #[arg(long)]
         quick: bool,
+    },
+    /// Measure the hard-disk equation of state under `exact`: Z against area fraction in a
+    /// periodic box, with block error bars, against Henderson's and Liu's equations; prints a
+    /// table and writes eos.csv, eos.svg and eos.png.
+    Eos {
+        /// Folder for eos.csv, eos.svg and eos.png.
+        #[arg(long, value_name = "DIR", default_value = "out")]
+        out: PathBuf,
+        /// Disks in the box (65536 for the liquid-hexatic region).
+        #[arg(long, default_value_t = 4096)]
+        n: usize,
+        /// Area fractions, comma-separated, each in (0, 0.85]. Default: 0.05 to 0.65 by 0.05,
+        /// then 0.68, 0.70, 0.72.
+        #[arg(long, value_delimiter = ',', value_name = "ETA,...")]
+        area_fractions: Option<Vec<f64>>,
+        /// Collisions per disk run first and discarded (melting the lattice, equilibrating).
+        #[arg(long, default_value_t = 100.0)]
+        equilibrate: f64,
+        /// Blocks measured after that.
+        #[arg(long, default_value_t = 10)]
+        blocks: usize,
+        /// Collisions per disk in each block.
+        #[arg(long, default_value_t = 100.0)]
+        block: f64,
+        /// Seed of the velocities.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
     },
     /// Print the systems a scene schedules, one per line.
     Systems {
@@ -210,6 +237,26 @@ fn main() -> ExitCode {
         Some(Command::Systems { scene }) => commands::systems::systems(&scene).map(|()| 0),
         Some(Command::Accuracy { out, scenes, quick }) => {
             commands::accuracy::accuracy(&out, &scenes, quick).map(|()| 0)
+        }
+        Some(Command::Eos {
+            out,
+            n,
+            area_fractions,
+            equilibrate,
+            blocks,
+            block,
+            seed,
+        }) => {
+            let options = moving_circles::eos::EosOptions {
+                n,
+                area_fractions: area_fractions
+                    .unwrap_or_else(|| moving_circles::eos::DEFAULT_AREA_FRACTIONS.to_vec()),
+                equilibrate,
+                blocks,
+                block,
+                seed,
+            };
+            commands::eos::eos(&options, &out).map(|()| 0)
         }
         None => open_app(cli.app).map(|()| 0),
     };

@@ -1,28 +1,22 @@
-//! The study's figure, as SVG text ([`svg`]) and PNG bytes ([`png`]) from one drawing: a row
+//! The study's figure ([`AccuracyFigure`], written as SVG and PNG through [`crate::figure`]): a row
 //! of panels per scene, one panel per error measure ([`MEASURES`]), each plotting error
 //! against cost (ms per simulated second) on log axes. A line joins one solver's runs at 30, 60 and 120 Hz
 //! (marker shape gives the rate), the `exact` reference is a dashed vertical line at its cost
 //! (error 0 by definition), errors of exactly 0 sit on the axis's bottom line labelled `0`,
 //! and a grey band marks the Pareto front. The legend has a strip of its own above the panels.
 
-use std::sync::Once;
-
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
 
 use super::front::{MEASURES, Measure, Panel, cost, of_scene, rate, scenes};
 use super::measure::Row;
+use crate::figure::{Figure, decades, err, font};
 
 /// The figure's size in pixels (SVG user units and PNG pixels alike).
 pub const FIGURE_SIZE: (u32, u32) = (1600, 1290);
 
 /// Height of the title and legend strip above the panels.
 const STRIP: u32 = 130;
-
-/// The typeface for all text, embedded so the PNG needs no system fonts (DejaVu Sans; its
-/// licence is beside it in `assets/fonts`).
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// One colour per solver setting: a family shares a hue (substeps from light to dark).
 const SETTINGS: [(&str, RGBColor); 7] = [
@@ -38,53 +32,28 @@ const SETTINGS: [(&str, RGBColor); 7] = [
 const FRONT: RGBColor = RGBColor(255, 200, 60);
 const GRID: RGBColor = RGBColor(225, 225, 225);
 
-/// The figure as SVG text.
-pub fn svg(rows: &[Row]) -> Result<String, String> {
-    let mut text = String::new();
-    draw(
-        SVGBackend::with_string(&mut text, FIGURE_SIZE).into_drawing_area(),
-        rows,
-    )?;
-    Ok(text)
-}
+/// The study's figure for `rows`.
+pub struct AccuracyFigure<'a>(pub &'a [Row]);
 
-/// The figure as PNG bytes.
-pub fn png(rows: &[Row]) -> Result<Vec<u8>, String> {
-    let (width, height) = FIGURE_SIZE;
-    let mut rgb = vec![0u8; width as usize * height as usize * 3];
-    draw(
-        BitMapBackend::with_buffer(&mut rgb, FIGURE_SIZE).into_drawing_area(),
-        rows,
-    )?;
-    let mut bytes = Vec::new();
-    let mut encoder = png::Encoder::new(&mut bytes, width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
-    writer.finish().map_err(|e| e.to_string())?;
-    Ok(bytes)
-}
-
-/// Draws the whole figure on `root`.
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, rows: &[Row]) -> Result<(), String> {
-    static FONTS: Once = Once::new();
-    FONTS.call_once(|| {
-        let parsed = register_font("sans-serif", FontStyle::Normal, FONT).is_ok();
-        assert!(parsed, "the embedded font parses");
-    });
-    root.fill(&WHITE).map_err(err)?;
-    let (strip, grid) = root.split_vertically(STRIP);
-    legend(&strip, rows)?;
-    let scenes = scenes(rows);
-    let panels = grid.split_evenly((scenes.len().max(1), MEASURES.len()));
-    for (s, scene) in scenes.iter().enumerate() {
-        let mine = of_scene(rows, scene);
-        for (m, measure) in MEASURES.iter().enumerate() {
-            panel(&panels[s * MEASURES.len() + m], &mine, measure)?;
-        }
+impl Figure for AccuracyFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        FIGURE_SIZE
     }
-    root.present().map_err(err)
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let rows = self.0;
+        let (strip, grid) = root.split_vertically(STRIP);
+        legend(&strip, rows)?;
+        let scenes = scenes(rows);
+        let panels = grid.split_evenly((scenes.len().max(1), MEASURES.len()));
+        for (s, scene) in scenes.iter().enumerate() {
+            let mine = of_scene(rows, scene);
+            for (m, measure) in MEASURES.iter().enumerate() {
+                panel(&panels[s * MEASURES.len() + m], &mine, measure)?;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The title and the legend: settings, rates, the reference and the front.
@@ -292,22 +261,6 @@ fn marker<DB: DrawingBackend, CT: CoordTranslate>(
     .map_err(err)
 }
 
-/// The whole decades around the positive `values`: `(10^floor(log min), 10^ceil(log max))`,
-/// at least one decade apart; `None` when there are none.
-fn decades(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
-    if lo > hi {
-        return None;
-    }
-    let lo = lo.log10().floor();
-    let hi = hi.log10().ceil().max(lo + 1.0);
-    Some((10f64.powf(lo), 10f64.powf(hi)))
-}
-
 /// Ticks at whole decades from `lo` to `hi` (both decades), every decade or every few so there
 /// are at most seven, always including `lo`.
 fn ticks(lo: f64, hi: f64) -> Vec<f64> {
@@ -330,12 +283,4 @@ fn decade_label(v: f64, zero: Option<f64>) -> String {
         k @ -2..=3 => format!("{}", 10f64.powi(k)),
         k => format!("1e{k}"),
     }
-}
-
-fn font(size: u32) -> TextStyle<'static> {
-    ("sans-serif", size).into_font().color(&BLACK)
-}
-
-fn err(e: impl std::fmt::Display) -> String {
-    e.to_string()
 }

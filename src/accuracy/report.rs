@@ -1,19 +1,8 @@
-//! The study's results as text: a CSV with one column per [`Row`] field (written through
-//! serde, so the columns are the struct's), the fixed-width table the command prints, and the
-//! Pareto fronts as text.
+//! The study's results as text: the fixed-width table the command prints and the Pareto fronts
+//! (the CSV, one column per [`Row`] field, is written by [`crate::io::csv_text`]).
 
 use super::front::{MEASURES, Panel, of_scene, scenes};
 use super::measure::Row;
-
-/// The study as CSV text, a header line then one line per row.
-pub fn to_csv(rows: &[Row]) -> Result<String, csv::Error> {
-    let mut writer = csv::Writer::from_writer(Vec::new());
-    for row in rows {
-        writer.serialize(row)?;
-    }
-    let bytes = writer.into_inner().map_err(|e| e.into_error())?;
-    Ok(String::from_utf8(bytes).expect("CSV of numbers and names is UTF-8"))
-}
 
 /// The study as a fixed-width table.
 pub fn to_table(rows: &[Row]) -> String {
@@ -80,6 +69,7 @@ pub fn to_fronts(rows: &[Row]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::csv_text;
 
     #[test]
     fn the_csv_has_one_column_per_field_and_empty_cells_for_missing_values() {
@@ -105,7 +95,7 @@ mod tests {
             z_error: Some(0.01),
             speed_ks: 0.0,
         };
-        let csv = to_csv(&[row]).unwrap();
+        let csv = csv_text(&[row]).unwrap();
         let mut lines = csv.lines();
         let header: Vec<&str> = lines.next().unwrap().split(',').collect();
         let cells: Vec<&str> = lines.next().unwrap().split(',').collect();

@@ -5,10 +5,11 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use crate::accuracy::plot::{png, svg};
-use crate::accuracy::report::{to_csv, to_fronts, to_table};
+use crate::accuracy::plot::AccuracyFigure;
+use crate::accuracy::report::{to_fronts, to_table};
 use crate::accuracy::{default_cases, settings, study};
-use crate::io::{say, write_atomically};
+use crate::figure::{png, svg};
+use crate::io::{csv_text, say, write_atomically};
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
 /// writes its CSV and plot into `out`.
@@ -33,15 +34,17 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     to_table(&rows).lines().for_each(say);
     to_fronts(&rows).lines().for_each(say);
     let csv = out.join("accuracy.csv");
-    let text = to_csv(&rows).context("formatting the CSV")?;
+    let text = csv_text(&rows).context("formatting the CSV")?;
     write_atomically(&csv, text.as_bytes())
         .with_context(|| format!("writing {}", csv.display()))?;
     let figure = out.join("accuracy.svg");
-    let drawing = svg(&rows).map_err(|e| anyhow::anyhow!("drawing {}: {e}", figure.display()))?;
+    let drawing = svg(&AccuracyFigure(&rows))
+        .map_err(|e| anyhow::anyhow!("drawing {}: {e}", figure.display()))?;
     write_atomically(&figure, drawing.as_bytes())
         .with_context(|| format!("writing {}", figure.display()))?;
     let picture = out.join("accuracy.png");
-    let bytes = png(&rows).map_err(|e| anyhow::anyhow!("drawing {}: {e}", picture.display()))?;
+    let bytes = png(&AccuracyFigure(&rows))
+        .map_err(|e| anyhow::anyhow!("drawing {}: {e}", picture.display()))?;
     write_atomically(&picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
     say(format_args!(
         "wrote {}, {} and {}",

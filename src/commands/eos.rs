@@ -1,0 +1,69 @@
+//! `moving_circles eos`: the hard-disk equation of state, one area fraction after another with
+//! a progress bar; prints a table and writes `eos.csv`, `eos.svg` and `eos.png`.
+
+use std::path::Path;
+
+use anyhow::Context;
+
+use crate::eos::plot::EosFigure;
+use crate::eos::{EosOptions, EosPoint, measure};
+use crate::figure::{png, svg};
+use crate::io::{check_output_path, csv_text, say, write_atomically};
+
+/// Measures every area fraction of `options` and writes the results into `out`.
+pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
+    options.check()?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let files = ["eos.csv", "eos.svg", "eos.png"].map(|name| out.join(name));
+    for file in &files {
+        check_output_path(file).with_context(|| format!("cannot write {}", file.display()))?;
+    }
+    let bar = indicatif::ProgressBar::new(options.area_fractions.len() as u64).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} area fractions  {msg}")
+            .expect("valid template"),
+    );
+    say(format_args!(
+        "{:>6} {:>6} {:>9} {:>8} {:>9} {:>9} {:>8} {:>10} {:>7} {:>7}",
+        "eta", "n", "Z", "± err", "Henderson", "Liu", "vs Liu", "collisions", "KS", "s"
+    ));
+    let mut points = Vec::new();
+    for &phi in &options.area_fractions {
+        bar.set_message(format!("η = {phi}"));
+        let point = measure(options, phi).map_err(anyhow::Error::msg)?;
+        bar.suspend(|| say(row(&point)));
+        bar.inc(1);
+        points.push(point);
+    }
+    bar.finish_and_clear();
+    let [csv, figure, picture] = &files;
+    write_atomically(csv, csv_text(&points)?.as_bytes())
+        .with_context(|| format!("writing {}", csv.display()))?;
+    let drawing = svg(&EosFigure(&points)).map_err(anyhow::Error::msg)?;
+    write_atomically(figure, drawing.as_bytes())
+        .with_context(|| format!("writing {}", figure.display()))?;
+    let bytes = png(&EosFigure(&points)).map_err(anyhow::Error::msg)?;
+    write_atomically(picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
+    say(format_args!(
+        "wrote {}, {} and {}",
+        csv.display(),
+        figure.display(),
+        picture.display()
+    ));
+    Ok(())
+}
+
+fn row(p: &EosPoint) -> String {
+    format!(
+        "{:>6} {:>6} {:>9.4} {:>8.4} {:>9.4} {:>9.4} {:>+7.2}% {:>10} {:>7.4} {:>7.1}",
+        p.area_fraction,
+        p.n,
+        p.z,
+        p.z_error,
+        p.henderson,
+        p.liu,
+        100.0 * p.vs_liu,
+        p.collisions,
+        p.speed_ks,
+        p.wall_seconds
+    )
+}

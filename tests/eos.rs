@@ -1,0 +1,108 @@
+//! `moving_circles eos`: the measured hard-disk pressure agrees with Liu's equation of state
+//! and the speeds with the Rayleigh law on a small box, the command writes its CSV and figure,
+//! and bad options are refused with the option named.
+
+use std::process::Command;
+
+use moving_circles::eos::theory::ks_critical_5_percent;
+use moving_circles::eos::{EosOptions, measure};
+
+fn small(area_fractions: Vec<f64>) -> EosOptions {
+    EosOptions {
+        n: 400,
+        area_fractions,
+        equilibrate: 30.0,
+        blocks: 5,
+        block: 40.0,
+        seed: 3,
+    }
+}
+
+#[test]
+fn a_small_box_gives_liu_s_pressure_and_rayleigh_speeds() {
+    let options = small(vec![0.3]);
+    options.check().unwrap();
+    let point = measure(&options, 0.3).unwrap();
+    assert_eq!(point.n, 400);
+    // 400 disks and 200 collisions each: a few tenths of a per cent of statistical error.
+    assert!(point.vs_liu.abs() < 0.01, "{point:?}");
+    assert!(
+        point.z_error > 0.0 && point.z_error < 0.01 * point.z,
+        "{point:?}"
+    );
+    assert!(
+        (point.vs_liu * point.liu).abs() < 4.0 * point.z_error + 0.005 * point.liu,
+        "the deviation is within the error bars: {point:?}"
+    );
+    // Every disk started at speed 1; the collisions made the speeds Rayleigh.
+    assert!(point.speed_ks < ks_critical_5_percent(400), "{point:?}");
+    let measured_pairs = (200.0 * 400.0 / 2.0) as u64;
+    assert!(point.collisions >= measured_pairs, "{point:?}");
+}
+
+#[test]
+fn the_command_writes_a_csv_and_the_figure_and_refuses_bad_options() {
+    let out = std::env::temp_dir().join(format!("mc-eos-{}", std::process::id()));
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+            .arg("eos")
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let out_arg = out.to_str().unwrap();
+    let done = run(&[
+        "--out",
+        out_arg,
+        "--n",
+        "64",
+        "--area-fractions",
+        "0.1,0.6",
+        "--equilibrate",
+        "5",
+        "--blocks",
+        "2",
+        "--block",
+        "5",
+    ]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("eos.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for column in [
+        "area_fraction",
+        "z",
+        "z_error",
+        "henderson",
+        "liu",
+        "speed_ks",
+    ] {
+        assert!(header.contains(&column), "{column} missing: {header:?}");
+    }
+    assert_eq!(lines.count(), 2, "one row per area fraction");
+    let svg = std::fs::read_to_string(out.join("eos.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("Liu"));
+    let png = std::fs::read(out.join("eos.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
+
+    for (args, field) in [
+        (vec!["--area-fractions", "0.9"], "area-fractions"),
+        (vec!["--area-fractions", "0"], "area-fractions"),
+        (vec!["--blocks", "1"], "blocks"),
+        (vec!["--n", "1"], "n"),
+        (vec!["--block", "NaN"], "block"),
+        (vec!["--equilibrate", "1e300"], "equilibrate"),
+    ] {
+        let mut all = vec!["--out", out_arg];
+        all.extend(args.iter());
+        let refused = run(&all);
+        let stderr = String::from_utf8_lossy(&refused.stderr);
+        assert!(!refused.status.success(), "{args:?} accepted");
+        assert!(stderr.contains(field), "{args:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
