@@ -70,6 +70,20 @@ pub struct StepTotals {
     pub sim_seconds: f64,
 }
 
+impl StepTotals {
+    /// What was advanced between `earlier` and these totals (all zero across a respawn, which
+    /// restarts the totals).
+    pub fn since(&self, earlier: &StepTotals) -> StepTotals {
+        if self.steps < earlier.steps {
+            return StepTotals::default();
+        }
+        StepTotals {
+            steps: self.steps - earlier.steps,
+            sim_seconds: self.sim_seconds - earlier.sim_seconds,
+        }
+    }
+}
+
 /// The core plugin: inserts the arena, segment walls, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
 /// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
 #[derive(Clone, Debug)]

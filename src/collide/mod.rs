@@ -55,6 +55,22 @@ pub struct PairCollisions {
     pub immovable_impulse: bevy::math::DVec2,
 }
 
+impl PairCollisions {
+    /// The collisions between `earlier` and these counters (all zero across a respawn, which
+    /// restarts the counters).
+    pub fn since(&self, earlier: &PairCollisions) -> PairCollisions {
+        if self.count < earlier.count {
+            return PairCollisions::default();
+        }
+        PairCollisions {
+            count: self.count - earlier.count,
+            virial: self.virial - earlier.virial,
+            immovable_work: self.immovable_work - earlier.immovable_work,
+            immovable_impulse: self.immovable_impulse - earlier.immovable_impulse,
+        }
+    }
+}
+
 /// Gathers the circles, resolves their contacts with [`resolve_all_contacts`] and writes back
 /// what changed; with `effects.hit_messages`, writes a [`CircleHit`] per collision.
 #[allow(clippy::too_many_arguments)]

@@ -5,10 +5,10 @@ use std::path::Path;
 
 use anyhow::Context;
 
+use super::write_figure;
 use crate::accuracy::plot::AccuracyFigure;
 use crate::accuracy::report::{to_fronts, to_table};
 use crate::accuracy::{default_cases, settings, study};
-use crate::figure::{png, svg};
 use crate::io::{csv_text, say, write_atomically};
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
@@ -37,15 +37,7 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     let text = csv_text(&rows).context("formatting the CSV")?;
     write_atomically(&csv, text.as_bytes())
         .with_context(|| format!("writing {}", csv.display()))?;
-    let figure = out.join("accuracy.svg");
-    let drawing = svg(&AccuracyFigure(&rows))
-        .map_err(|e| anyhow::anyhow!("drawing {}: {e}", figure.display()))?;
-    write_atomically(&figure, drawing.as_bytes())
-        .with_context(|| format!("writing {}", figure.display()))?;
-    let picture = out.join("accuracy.png");
-    let bytes = png(&AccuracyFigure(&rows))
-        .map_err(|e| anyhow::anyhow!("drawing {}: {e}", picture.display()))?;
-    write_atomically(&picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
+    let [figure, picture] = write_figure(&AccuracyFigure(&rows), out, "accuracy")?;
     say(format_args!(
         "wrote {}, {} and {}",
         csv.display(),

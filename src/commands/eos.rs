@@ -5,9 +5,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
+use super::write_figure;
 use crate::eos::plot::EosFigure;
 use crate::eos::{EosOptions, EosPoint, measure};
-use crate::figure::{png, svg};
 use crate::io::{check_output_path, csv_text, say, write_atomically};
 
 /// Measures every area fraction of `options` and writes the results into `out`.
@@ -35,14 +35,10 @@ pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
         points.push(point);
     }
     bar.finish_and_clear();
-    let [csv, figure, picture] = &files;
+    let csv = &files[0];
     write_atomically(csv, csv_text(&points)?.as_bytes())
         .with_context(|| format!("writing {}", csv.display()))?;
-    let drawing = svg(&EosFigure(&points)).map_err(anyhow::Error::msg)?;
-    write_atomically(figure, drawing.as_bytes())
-        .with_context(|| format!("writing {}", figure.display()))?;
-    let bytes = png(&EosFigure(&points)).map_err(anyhow::Error::msg)?;
-    write_atomically(picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
+    let [figure, picture] = write_figure(&EosFigure(&points), out, "eos")?;
     say(format_args!(
         "wrote {}, {} and {}",
         csv.display(),

@@ -211,15 +211,7 @@ pub fn measure(options: &EosOptions, phi: f64) -> Result<EosPoint, String> {
     for _ in 0..options.blocks {
         run_until(&mut app, options.block)?;
         let after = counters(&app);
-        let window = StepTotals {
-            steps: after.0.steps - before.0.steps,
-            sim_seconds: after.0.sim_seconds - before.0.sim_seconds,
-        };
-        let pairs = PairCollisions {
-            count: after.1.count - before.1.count,
-            virial: after.1.virial - before.1.virial,
-            ..PairCollisions::default()
-        };
+        let (window, pairs) = (after.0.since(&before.0), after.1.since(&before.1));
         let world = app.world();
         let diagnostics = world.resource::<CircleDiagnostics>();
         let pressure = Pressure::measure(

@@ -94,21 +94,9 @@ pub(super) fn sample(
     let Some((_, then_totals, then_pairs)) = previous else {
         return;
     };
-    // Counters restart at a reset: a window that spans one is measured from zero.
-    let (then_totals, then_pairs) = if totals.steps < then_totals.steps {
-        (StepTotals::default(), PairCollisions::default())
-    } else {
-        (then_totals, then_pairs)
-    };
-    let window = StepTotals {
-        steps: totals.steps - then_totals.steps,
-        sim_seconds: totals.sim_seconds - then_totals.sim_seconds,
-    };
-    let window_pairs = PairCollisions {
-        count: pairs.count - then_pairs.count,
-        virial: pairs.virial - then_pairs.virial,
-        ..default()
-    };
+    // Counters restart at a reset: a window that spans one measures nothing.
+    let window = totals.since(&then_totals);
+    let window_pairs = pairs.since(&then_pairs);
     let discs: Vec<_> = circles.iter().map(|(p, r)| (p.0, r.0)).collect();
     let pressure = Pressure::measure(
         &window,
