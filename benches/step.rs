@@ -123,5 +123,33 @@ fn segments(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, solvers, effects, hit_messages, segments);
+/// What a point of `moving_circles eos` costs through the app (lattice, melting, blocks, the
+/// speed test): 4096 disks at area fractions 0.3 and 0.7, 20 collisions per disk discarded and
+/// 4 blocks of 20 measured; throughput in pair collisions (engine alone: `exact_density` in
+/// the kernels bench).
+fn eos_point(c: &mut Criterion) {
+    use moving_circles::eos::{EosOptions, measure};
+    let mut group = c.benchmark_group("eos_point");
+    group.sample_size(10);
+    for phi in [0.3, 0.7] {
+        let options = EosOptions {
+            n: 4096,
+            area_fractions: vec![phi],
+            equilibrate: 20.0,
+            blocks: 4,
+            block: 20.0,
+            seed: 1,
+        };
+        // All the collisions a point processes, melting included (deterministic).
+        let point = measure(&options, phi).expect("collides");
+        let melting = (options.equilibrate * 4096.0 / 2.0) as u64;
+        group.throughput(Throughput::Elements(point.collisions + melting));
+        group.bench_with_input(BenchmarkId::from_parameter(phi), &phi, |b, &phi| {
+            b.iter(|| measure(&options, phi).expect("collides"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, solvers, effects, hit_messages, segments, eos_point);
 criterion_main!(benches);
