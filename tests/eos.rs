@@ -51,13 +51,14 @@ fn the_command_writes_a_csv_and_the_figure_and_refuses_bad_options() {
             .unwrap()
     };
     let out_arg = out.to_str().unwrap();
+    // At 0.001 a mean free time is longer than the longest step a scene may have.
     let done = run(&[
         "--out",
         out_arg,
         "--n",
         "64",
         "--area-fractions",
-        "0.1,0.6",
+        "0.001,0.6",
         "--equilibrate",
         "5",
         "--blocks",

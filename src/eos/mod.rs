@@ -21,7 +21,7 @@ use crate::arena::{Arena, Boundary};
 use crate::boundary::WallCollisions;
 use crate::circle::snapshot;
 use crate::collide::PairCollisions;
-use crate::config::{CirclesConfig, Effects, MassModel, Placement, Solver, SpawnConfig};
+use crate::config::{CirclesConfig, DT_RANGE, Effects, MassModel, Placement, Solver, SpawnConfig};
 use crate::diagnostics::{CircleDiagnostics, Pressure};
 use crate::error::FieldError;
 use crate::run::headless_app;
@@ -157,9 +157,15 @@ pub fn config(n: usize, phi: f64, seed: u64) -> CirclesConfig {
         },
         solver: Solver::Exact,
         effects: Effects::default(),
-        dt: mean_free_time(phi),
+        dt: step(phi),
         ..CirclesConfig::default()
     }
+}
+
+/// The step: about one mean free time, but no longer than the longest step a scene may have
+/// (which dilute boxes reach).
+fn step(phi: f64) -> f64 {
+    mean_free_time(phi).min(DT_RANGE.1)
 }
 
 /// About the mean free time of unit-diameter disks with `kT/m = ½` at area fraction `phi`:
@@ -192,7 +198,8 @@ pub fn measure(options: &EosOptions, phi: f64) -> Result<EosPoint, String> {
             app.world().resource::<PairCollisions>().count,
             pair_target(per_disk),
         );
-        let most_steps = (100.0 * per_disk).ceil() as u64 + 1000;
+        let steps_per_free_time = (mean_free_time(phi) / step(phi)).ceil();
+        let most_steps = (100.0 * per_disk * steps_per_free_time).ceil() as u64 + 1000;
         for _ in 0..most_steps {
             if app.world().resource::<PairCollisions>().count - start >= pairs {
                 return Ok(());
