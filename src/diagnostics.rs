@@ -38,18 +38,31 @@ impl Pressure {
         kinetic_energy: f64,
         arena: &Arena,
     ) -> Self {
-        let t = elapsed.sim_seconds;
-        let n_kt = kinetic_energy; // N·kT = total kinetic energy in 2D
-        if !(t > 0.0 && n > 0 && n_kt > 0.0) {
+        let Some(z_virial) = Self::virial_z(elapsed, pairs, n, kinetic_energy) else {
             return Self::default();
-        }
+        };
+        let (t, n_kt) = (elapsed.sim_seconds, kinetic_energy);
         let size = arena.size();
         let area = size.x * size.y;
         let perimeter = 2.0 * (size.x + size.y);
         Self {
-            z_virial: Some(1.0 + pairs.virial / (2.0 * t * n_kt)),
+            z_virial: Some(z_virial),
             z_wall: (!arena.is_periodic()).then(|| walls.impulse / (t * perimeter) * area / n_kt),
         }
+    }
+
+    /// `z` from the collisional virial alone (see [`Pressure::z_virial`]), for any window of
+    /// the counters: what a periodic box or a window of samples needs. `None` where it is
+    /// undefined (no time, no circles, no motion).
+    pub fn virial_z(
+        elapsed: &StepTotals,
+        pairs: &PairCollisions,
+        n: usize,
+        kinetic_energy: f64,
+    ) -> Option<f64> {
+        let t = elapsed.sim_seconds;
+        let n_kt = kinetic_energy; // N·kT = total kinetic energy in 2D
+        (t > 0.0 && n > 0 && n_kt > 0.0).then(|| 1.0 + pairs.virial / (2.0 * t * n_kt))
     }
 }
 

@@ -18,7 +18,6 @@ use bevy::math::DVec2;
 use serde::Serialize;
 
 use crate::arena::{Arena, Boundary};
-use crate::boundary::WallCollisions;
 use crate::circle::snapshot;
 use crate::collide::PairCollisions;
 use crate::config::{CirclesConfig, DT_RANGE, Effects, MassModel, Placement, Solver, SpawnConfig};
@@ -219,17 +218,14 @@ pub fn measure(options: &EosOptions, phi: f64) -> Result<EosPoint, String> {
         run_until(&mut app, options.block)?;
         let after = counters(&app);
         let (window, pairs) = (after.0.since(&before.0), after.1.since(&before.1));
-        let world = app.world();
-        let diagnostics = world.resource::<CircleDiagnostics>();
-        let pressure = Pressure::measure(
+        let diagnostics = app.world().resource::<CircleDiagnostics>();
+        let z = Pressure::virial_z(
             &window,
             &pairs,
-            &WallCollisions::default(),
             diagnostics.count,
             diagnostics.kinetic_energy,
-            world.resource::<Arena>(),
         );
-        blocks.push(pressure.z_virial.unwrap_or(f64::NAN));
+        blocks.push(z.unwrap_or(f64::NAN));
         before = after;
     }
     let (z, z_error) = block_mean(&blocks).unwrap_or((f64::NAN, f64::NAN));

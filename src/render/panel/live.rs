@@ -9,7 +9,6 @@ use std::time::{Duration, Instant};
 use bevy::prelude::*;
 
 use crate::arena::Arena;
-use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
 use crate::components::{Position, Radius};
@@ -98,13 +97,11 @@ pub(super) fn sample(
     let window = totals.since(&then_totals);
     let window_pairs = pairs.since(&then_pairs);
     let discs: Vec<_> = circles.iter().map(|(p, r)| (p.0, r.0)).collect();
-    let pressure = Pressure::measure(
+    let z = Pressure::virial_z(
         &window,
         &window_pairs,
-        &WallCollisions::default(),
         diagnostics.count,
         diagnostics.kinetic_energy,
-        &arena,
     );
     let sample = LiveSample {
         t: now,
@@ -112,7 +109,7 @@ pub(super) fn sample(
         ms_per_step: (steps > 0).then(|| 1e3 * spent.as_secs_f64() / steps as f64),
         collisions_per_second: (window.sim_seconds > 0.0)
             .then(|| window_pairs.count as f64 / window.sim_seconds),
-        z: pressure.z_virial,
+        z,
         overlap: Overlaps::measure(&discs, &arena).max,
         energy_drift: diagnostics.energy_drift(),
     };
