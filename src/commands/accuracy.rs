@@ -5,11 +5,11 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::write_figure;
+use super::write_results;
 use crate::accuracy::plot::AccuracyFigure;
 use crate::accuracy::report::{to_fronts, to_table};
 use crate::accuracy::{default_cases, settings, study};
-use crate::io::{csv_text, say, write_atomically};
+use crate::io::say;
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
 /// writes its CSV and plot into `out`.
@@ -33,16 +33,5 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     bar.finish_and_clear();
     to_table(&rows).lines().for_each(say);
     to_fronts(&rows).lines().for_each(say);
-    let csv = out.join("accuracy.csv");
-    let text = csv_text(&rows).context("formatting the CSV")?;
-    write_atomically(&csv, text.as_bytes())
-        .with_context(|| format!("writing {}", csv.display()))?;
-    let [figure, picture] = write_figure(&AccuracyFigure(&rows), out, "accuracy")?;
-    say(format_args!(
-        "wrote {}, {} and {}",
-        csv.display(),
-        figure.display(),
-        picture.display()
-    ));
-    Ok(())
+    write_results(&rows, &AccuracyFigure(&rows), out, "accuracy")
 }

@@ -5,10 +5,10 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::write_figure;
+use super::write_results;
 use crate::eos::plot::EosFigure;
 use crate::eos::{EosOptions, EosPoint, measure};
-use crate::io::{check_output_path, csv_text, say, write_atomically};
+use crate::io::{check_output_path, say};
 
 /// Measures every area fraction of `options` and writes the results into `out`.
 pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
@@ -35,17 +35,7 @@ pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
         points.push(point);
     }
     bar.finish_and_clear();
-    let csv = &files[0];
-    write_atomically(csv, csv_text(&points)?.as_bytes())
-        .with_context(|| format!("writing {}", csv.display()))?;
-    let [figure, picture] = write_figure(&EosFigure(&points), out, "eos")?;
-    say(format_args!(
-        "wrote {}, {} and {}",
-        csv.display(),
-        figure.display(),
-        picture.display()
-    ));
-    Ok(())
+    write_results(&points, &EosFigure(&points), out, "eos")
 }
 
 fn row(p: &EosPoint) -> String {

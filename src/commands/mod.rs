@@ -12,7 +12,7 @@ use std::path::Path;
 use anyhow::Context;
 
 use crate::figure::{Figure, png, svg};
-use crate::io::write_atomically;
+use crate::io::{csv_text, say, write_atomically};
 
 pub mod accuracy;
 #[cfg(feature = "render")]
@@ -21,20 +21,28 @@ pub mod eos;
 pub mod run;
 pub mod systems;
 
-/// Writes `figure` as `<stem>.svg` and `<stem>.png` inside `out`; the paths written.
-pub fn write_figure(
+/// Writes `rows` as `<stem>.csv` and `figure` as `<stem>.svg` and `<stem>.png` inside `out`,
+/// each atomically, and says what it wrote.
+pub fn write_results<T: serde::Serialize>(
+    rows: &[T],
     figure: &impl Figure,
     out: &Path,
     stem: &str,
-) -> anyhow::Result<[std::path::PathBuf; 2]> {
-    let (vector, picture) = (
-        out.join(format!("{stem}.svg")),
-        out.join(format!("{stem}.png")),
-    );
-    let text = svg(figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", vector.display()))?;
-    write_atomically(&vector, text.as_bytes())
+) -> anyhow::Result<()> {
+    let [csv, vector, picture] = ["csv", "svg", "png"].map(|ext| out.join(format!("{stem}.{ext}")));
+    let text = csv_text(rows).context("formatting the CSV")?;
+    write_atomically(&csv, text.as_bytes())
+        .with_context(|| format!("writing {}", csv.display()))?;
+    let drawing = svg(figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", vector.display()))?;
+    write_atomically(&vector, drawing.as_bytes())
         .with_context(|| format!("writing {}", vector.display()))?;
     let bytes = png(figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", picture.display()))?;
     write_atomically(&picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
-    Ok([vector, picture])
+    say(format_args!(
+        "wrote {}, {} and {}",
+        csv.display(),
+        vector.display(),
+        picture.display()
+    ));
+    Ok(())
 }
