@@ -88,15 +88,25 @@ fn single_step(world: &mut World) {
     }
 }
 
+/// The solvers the app switches between (keys `1` to `4`, and the panel's buttons).
+pub const APP_SOLVERS: [Solver; 4] = [
+    Solver::Discrete,
+    Solver::Substeps(8),
+    Solver::Swept,
+    Solver::Exact,
+];
+
 fn switch_solver(keys: Res<ButtonInput<KeyCode>>, mut solver: ResMut<Solver>) {
-    let chosen = [
-        (KeyCode::Digit1, Solver::Discrete),
-        (KeyCode::Digit2, Solver::Substeps(8)),
-        (KeyCode::Digit3, Solver::Swept),
-        (KeyCode::Digit4, Solver::Exact),
-    ]
-    .into_iter()
-    .find(|(key, _)| keys.just_pressed(*key));
+    let digits = [
+        KeyCode::Digit1,
+        KeyCode::Digit2,
+        KeyCode::Digit3,
+        KeyCode::Digit4,
+    ];
+    let chosen = digits
+        .into_iter()
+        .zip(APP_SOLVERS)
+        .find(|(key, _)| keys.just_pressed(*key));
     if let Some((_, new)) = chosen {
         *solver = new;
     }

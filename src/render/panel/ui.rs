@@ -16,7 +16,7 @@ use super::live::{LiveHistory, LiveSample};
 use crate::accuracy::Row;
 use crate::config::{Effects, Solver};
 use crate::diagnostics::CircleDiagnostics;
-use crate::render::input::MAX_COUNT;
+use crate::render::input::{APP_SOLVERS, MAX_COUNT};
 
 /// Slider values being dragged: a change that respawns is sent when the drag ends.
 #[derive(Resource, Clone, Copy, Debug, Default)]
@@ -34,13 +34,13 @@ pub struct Settings<'w> {
     virt: Res<'w, Time<Virtual>>,
 }
 
-/// The solvers the panel offers, with the colour each has in plots (as in the accuracy
-/// figure).
-const SOLVERS: [(Solver, [u8; 3]); 4] = [
-    (Solver::Discrete, [215, 48, 39]),
-    (Solver::Substeps(8), [35, 139, 69]),
-    (Solver::Swept, [33, 113, 181]),
-    (Solver::Exact, [160, 120, 230]),
+/// Each solver's colour in the plots (as in the accuracy figure, lighter for exact on the dark
+/// panel), in the order of [`APP_SOLVERS`].
+const COLOURS: [[u8; 3]; 4] = [
+    [215, 48, 39],
+    [35, 139, 69],
+    [33, 113, 181],
+    [160, 120, 230],
 ];
 
 /// Draws the panel when it is shown.
@@ -85,7 +85,7 @@ pub fn draw_panel(
 fn solver_buttons(ui: &mut egui::Ui, current: Solver, sent: &mut Vec<Control>) {
     ui.horizontal(|ui| {
         ui.label("solver");
-        for (solver, _) in SOLVERS {
+        for solver in APP_SOLVERS {
             if ui
                 .selectable_label(current == solver, solver.to_string())
                 .clicked()
@@ -237,10 +237,11 @@ fn tick(v: f64) -> String {
 }
 
 fn colour(solver: Solver) -> [u8; 3] {
-    SOLVERS
+    APP_SOLVERS
         .iter()
-        .find(|(s, _)| std::mem::discriminant(s) == std::mem::discriminant(&solver))
-        .map_or([200, 200, 200], |(_, c)| *c)
+        .zip(COLOURS)
+        .find(|(s, _)| std::mem::discriminant(*s) == std::mem::discriminant(&solver))
+        .map_or([200, 200, 200], |(_, c)| c)
 }
 
 fn comparison_section(ui: &mut egui::Ui, comparison: &Comparison, sent: &mut Vec<Control>) {
