@@ -45,7 +45,7 @@ fn reference(mut circles: Vec<CircleState>, periodic: bool, t_end: f64) -> (Vec<
             for axis in 0..2 {
                 if !periodic
                     && let Some((t, _)) =
-                        wall_time_of_impact(a.position[axis], a.velocity[axis], r, 1.0 - r)
+                        wall_time_of_impact(a.position[axis], a.velocity[axis], r, 1.0 - r, 0.0)
                 {
                     consider(t, i, None, axis);
                 }

@@ -30,16 +30,61 @@ pub fn pair_time_of_impact(dp: DVec2, dv: DVec2, sigma: f64) -> Option<f64> {
     t.is_finite().then_some(t.max(0.0))
 }
 
+/// [`pair_time_of_impact`] for circles whose radii grow (a compression): the smallest `τ ≥ 0`
+/// with `|dp + dv·τ| = σ + γ·τ`, where `γ` is how fast the sum of the radii grows.
+///
+/// Growth catches up with any pair that does not fly apart faster than it: a pair separating
+/// slower than `γ` meets again. Touching or overlapping by rounding, a pair collides now if its
+/// gap closes (`dp·dv < σγ`) and otherwise next when growth has closed it again. With `γ = 0`
+/// this is [`pair_time_of_impact`].
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::exact::toi::growing_pair_time_of_impact;
+///
+/// // At rest, 3 apart, radii summing to 1 and growing at 0.5: they touch at τ = 4.
+/// let t = growing_pair_time_of_impact(DVec2::new(3.0, 0.0), DVec2::ZERO, 1.0, 0.5);
+/// assert_eq!(t, Some(4.0));
+/// ```
+pub fn growing_pair_time_of_impact(dp: DVec2, dv: DVec2, sigma: f64, gamma: f64) -> Option<f64> {
+    // |dp + dv·τ|² - (σ + γτ)² = aτ² + 2bτ + c.
+    let b = dp.dot(dv) - sigma * gamma;
+    let a = dv.length_squared() - gamma * gamma;
+    let c = dp.length_squared() - sigma * sigma;
+    let t = if b < 0.0 {
+        if c <= 0.0 {
+            return Some(0.0); // touching and closing
+        }
+        let disc = b * b - a * c;
+        if disc < 0.0 {
+            return None; // closest approach misses (only when they outrun the growth)
+        }
+        c / (-b + disc.sqrt())
+    } else {
+        if a >= 0.0 {
+            return None; // flying apart faster than they grow, for good
+        }
+        // Growth outruns them: the later root, with `-a > 0` and `b ≥ 0`.
+        let disc = b * b - a * c;
+        if disc < 0.0 {
+            return None;
+        }
+        (b + disc.sqrt()) / -a
+    };
+    t.is_finite().then_some(t.max(0.0))
+}
+
 /// When a circle at `x` moving at `v` along one axis reaches the wall that keeps its centre in
 /// `[lo, hi]`, if it moves toward one: `(time, which)` with `which` 0 for `lo`, 1 for `hi`.
-/// A centre already past the wall it moves toward hits it now.
-pub fn wall_time_of_impact(x: f64, v: f64, lo: f64, hi: f64) -> Option<(f64, usize)> {
-    if v > 0.0 {
-        Some((((hi - x) / v).max(0.0), 1))
-    } else if v < 0.0 {
-        Some((((lo - x) / v).max(0.0), 0))
-    } else {
-        None
+/// A centre already past the wall it moves toward hits it now. `growth` is how fast the
+/// circle's radius grows (0 but in a compression): both bounds then close in at that speed, so
+/// a circle meets a wall it moves away from slower than it grows, and one at rest meets both.
+pub fn wall_time_of_impact(x: f64, v: f64, lo: f64, hi: f64, growth: f64) -> Option<(f64, usize)> {
+    let to_hi = (v + growth > 0.0).then(|| (((hi - x) / (v + growth)).max(0.0), 1));
+    let to_lo = (v - growth < 0.0).then(|| (((lo - x) / (v - growth)).max(0.0), 0));
+    match (to_lo, to_hi) {
+        (Some(l), Some(h)) => Some(if h.0 < l.0 { h } else { l }),
+        (l, h) => l.or(h),
     }
 }
 
@@ -140,11 +185,54 @@ mod tests {
 
     #[test]
     fn walls_are_hit_in_the_direction_of_motion() {
-        assert_eq!(wall_time_of_impact(0.5, 2.0, 0.1, 0.9), Some((0.2, 1)));
-        let (t, w) = wall_time_of_impact(0.5, -0.5, 0.1, 0.9).unwrap();
+        assert_eq!(wall_time_of_impact(0.5, 2.0, 0.1, 0.9, 0.0), Some((0.2, 1)));
+        let (t, w) = wall_time_of_impact(0.5, -0.5, 0.1, 0.9, 0.0).unwrap();
         assert!((t - 0.8).abs() < 1e-15 && w == 0);
-        assert_eq!(wall_time_of_impact(0.95, 1.0, 0.1, 0.9), Some((0.0, 1)));
-        assert_eq!(wall_time_of_impact(0.5, 0.0, 0.1, 0.9), None);
+        assert_eq!(
+            wall_time_of_impact(0.95, 1.0, 0.1, 0.9, 0.0),
+            Some((0.0, 1))
+        );
+        assert_eq!(wall_time_of_impact(0.5, 0.0, 0.1, 0.9, 0.0), None);
+    }
+
+    #[test]
+    fn growing_circles_meet_walls_they_move_away_from() {
+        let close = |got: Option<(f64, usize)>, t: f64, wall: usize| {
+            let (at, which) = got.unwrap();
+            assert!((at - t).abs() < 1e-15 && which == wall, "{got:?}");
+        };
+        // At rest, growing at 0.1: the nearer wall (0.2 away) first.
+        close(wall_time_of_impact(0.3, 0.0, 0.1, 0.9, 0.1), 2.0, 0);
+        // Moving to the high wall at 0.1, growing at 0.1: closes at 0.2 there, 0 to the low one.
+        close(wall_time_of_impact(0.5, 0.1, 0.1, 0.9, 0.1), 2.0, 1);
+        // Moving away from the low wall faster than it grows: only the high wall.
+        close(wall_time_of_impact(0.2, 0.5, 0.1, 0.9, 0.1), 0.7 / 0.6, 1);
+    }
+
+    #[test]
+    fn growth_catches_up_with_slow_separation() {
+        // 2 apart and separating at 0.5, radii summing to 1 and growing at 1:
+        // 2 + 0.5τ = 1 + τ at τ = 2.
+        let t = growing_pair_time_of_impact(DVec2::new(2.0, 0.0), DVec2::new(0.5, 0.0), 1.0, 1.0);
+        assert_eq!(t, Some(2.0));
+        // Separating faster than they grow: never.
+        let never =
+            growing_pair_time_of_impact(DVec2::new(2.0, 0.0), DVec2::new(2.0, 0.0), 1.0, 1.0);
+        assert_eq!(never, None);
+        // Touching, separating slower than growth: closing in the frame of the surfaces, now.
+        let now = growing_pair_time_of_impact(DVec2::new(1.0, 0.0), DVec2::new(0.5, 0.0), 1.0, 1.0);
+        assert_eq!(now, Some(0.0));
+        // Without growth it is the plain time of impact.
+        for (dp, dv) in [
+            (DVec2::new(3.0, 0.4), DVec2::new(-2.0, 0.1)),
+            (DVec2::new(5.0, 1.0), DVec2::new(-1.0, 0.0)),
+            (DVec2::new(3.0, 2.0), DVec2::new(-1.0, 0.0)),
+        ] {
+            assert_eq!(
+                growing_pair_time_of_impact(dp, dv, 1.0, 0.0),
+                pair_time_of_impact(dp, dv, 1.0)
+            );
+        }
     }
 
     fn horizontal() -> Segment {

@@ -16,6 +16,7 @@
 //! looks only at its own cell's list, again after each crossing. Everything is f64.
 
 mod events;
+mod growth;
 mod predict;
 mod snapshot;
 mod walls;
@@ -84,6 +85,9 @@ pub struct EventEngine {
     own_restitution: Vec<f64>,
     /// Hits since the last [`EventEngine::drain_hits`], when recording.
     hits: Option<HitLog>,
+    /// How fast radii grow: circle `i`'s radius is `radius·(1 + growth·t)`. 0 but in a
+    /// compression ([`EventEngine::growing`]).
+    growth: f64,
 }
 
 impl EventEngine {
@@ -159,6 +163,7 @@ impl EventEngine {
             segment_cells,
             own_restitution: Vec::new(),
             hits: None,
+            growth: 0.0,
         };
         engine.relink_all();
         engine.predict_all();
@@ -286,12 +291,14 @@ impl EventEngine {
     /// which collide at once on the next advance.
     pub fn drift_to(&mut self, t: f64) {
         let arena = self.arena;
+        let scale = 1.0 + self.growth * t;
         for (m, count) in self.motion.iter_mut().zip(&mut self.counter) {
             let mut p = m.at(t);
             if arena.is_periodic() {
                 p = arena.wrap(p);
             } else {
-                reflect_off_walls(&mut p, &mut m.vel, m.radius, &arena, self.wall_restitution);
+                let r = m.radius * scale;
+                reflect_off_walls(&mut p, &mut m.vel, r, &arena, self.wall_restitution);
             }
             m.pos = p;
             m.t_at = t;
@@ -360,9 +367,12 @@ impl EventEngine {
             [] => self.restitution,
             own => combine_restitution(own[i], own[j]),
         };
+        // Growing radii bounce as if `b` came in slower by the rate the surfaces close at.
+        let surfaces = n * ((a.radius + b.radius) * self.growth);
+        vb -= surfaces;
         if let Some(impulse) = apply_impulse(n, &mut va, &mut vb, wa, wb, e) {
             self.motion[i].vel = va;
-            self.motion[j].vel = vb;
+            self.motion[j].vel = vb + surfaces;
             self.stats.pair_collisions += 1;
             self.stats.virial += (a.radius + b.radius) * impulse;
             if wa == 0.0 || wb == 0.0 {

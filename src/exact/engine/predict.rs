@@ -10,7 +10,9 @@ use bevy::math::DVec2;
 
 use super::EventEngine;
 use super::events::{BestPair, Event, Kind, NO_PAIR};
-use crate::exact::toi::{pair_time_of_impact, segment_time_of_impact, wall_time_of_impact};
+use crate::exact::toi::{
+    growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact, wall_time_of_impact,
+};
 use crate::grid::NONE;
 
 impl EventEngine {
@@ -43,7 +45,18 @@ impl EventEngine {
                     dp.x -= whole_periods(d.x, self.period.x);
                     dp.y -= whole_periods(d.y, self.period.y);
                 }
-                if let Some(t) = pair_time_of_impact(dp, dv, me.radius + other.radius)
+                let sum = me.radius + other.radius;
+                let impact = if self.growth == 0.0 {
+                    pair_time_of_impact(dp, dv, sum)
+                } else {
+                    growing_pair_time_of_impact(
+                        dp,
+                        dv,
+                        sum * (1.0 + self.growth * since),
+                        sum * self.growth,
+                    )
+                };
+                if let Some(t) = impact
                     && (since + t).max(now) < best.time
                 {
                     best = BestPair {
@@ -138,17 +151,20 @@ impl EventEngine {
         }
         let walls = !self.grid.periodic;
         let (min, max): (DVec2, DVec2) = (self.arena.min, self.arena.max);
+        let (r, growth) = (
+            m.radius * (1.0 + self.growth * since),
+            m.radius * self.growth,
+        );
         for axis in 0..2u8 {
             let a = axis as usize;
             let v = m.vel[a];
-            if v == 0.0 {
-                continue;
-            }
             if walls
-                && let Some((t, _)) =
-                    wall_time_of_impact(p[a], v, min[a] + m.radius, max[a] - m.radius)
+                && let Some((t, _)) = wall_time_of_impact(p[a], v, min[a] + r, max[a] - r, growth)
             {
                 consider(t, Kind::Wall { axis }, NONE);
+            }
+            if v == 0.0 {
+                continue;
             }
             // Cell crossing along this axis.
             let (cell, last) = if a == 0 {

@@ -130,6 +130,7 @@ impl EventEngine {
             segment_cells,
             own_restitution: Vec::new(),
             hits: None,
+            growth: 0.0,
         })
     }
 }

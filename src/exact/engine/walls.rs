@@ -23,13 +23,21 @@ impl EventEngine {
             [] => self.wall_restitution,
             own => combine_restitution(own[i], self.wall_restitution),
         };
+        let scale = 1.0 + self.growth * self.now;
         let m = &mut self.motion[i];
-        let (lo, hi) = (min[axis] + m.radius, max[axis] - m.radius);
+        let (r, growth) = (m.radius * scale, m.radius * self.growth);
+        let (lo, hi) = (min[axis] + r, max[axis] - r);
         let v = m.vel[axis];
-        // Snap onto the wall (the event time puts it there up to rounding) and reflect.
-        let high = v > 0.0;
+        // Snap onto the wall (the event time puts it there up to rounding) and reflect, off a
+        // wall that closes in at the rate the radius grows in a compression.
+        let high = if growth == 0.0 {
+            v > 0.0
+        } else {
+            hi - m.pos[axis] < m.pos[axis] - lo
+        };
         m.pos[axis] = if high { hi } else { lo };
-        let new_v = -e * v;
+        let wall_v = if high { -growth } else { growth };
+        let new_v = wall_v - e * (v - wall_v);
         m.vel[axis] = new_v;
         let centre = m.pos;
         let impulse = self.count_wall_hit(i, (new_v - v).abs());

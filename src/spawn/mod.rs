@@ -1,0 +1,197 @@
+//! Spawning circles: [`SpawnPlugin`] places them at startup and on [`Respawn`] requests, and
+//! drops circles in one at a time while the simulation runs ([`DropConfig`]). Where they go is
+//! worked out by [`place_circles`], a plain function over plain data.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::arena::Arena;
+use crate::circle::CircleState;
+use crate::components::Position;
+use crate::components::Radius;
+use crate::config::{DropConfig, SpawnConfig};
+use crate::schedule::CircleSystems;
+use crate::schedule::StepTotals;
+use crate::segment::Segments;
+
+mod place;
+
+pub use place::place_circles;
+use place::{hue_to_rgb, sample_between};
+
+/// Asks for all circles to be replaced by a fresh placement from the current [`SpawnConfig`]
+/// (after changing its `count`, say). Handled in `PreUpdate`, so it works while paused.
+#[derive(Message, Clone, Copy, Debug, Default)]
+pub struct Respawn;
+
+/// How the last placement went: what was asked for and what fit.
+#[derive(Resource, Clone, Debug, Default, PartialEq, Eq)]
+pub struct SpawnReport {
+    /// Circles requested.
+    pub requested: usize,
+    /// Circles placed.
+    pub placed: usize,
+    /// Increases with every placement, so observers can tell a reset happened.
+    pub generation: u64,
+    /// Why no random circles were placed, when the rules could not be followed (a compression
+    /// that jammed, say).
+    pub refused: Option<String>,
+}
+
+/// Circles a scene places exactly, before the random ones.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct FixedCircles(pub Vec<CircleState>);
+
+/// Spawns the [`FixedCircles`] and random circles from a [`SpawnConfig`] at startup and on
+/// every [`Respawn`].
+#[derive(Clone, Debug, Default)]
+pub struct SpawnPlugin {
+    /// Random circles to place.
+    pub config: SpawnConfig,
+    /// Circles to place exactly as given.
+    pub circles: Vec<CircleState>,
+    /// Circles to drop in one at a time while it runs.
+    pub drop: Option<DropConfig>,
+}
+
+impl Plugin for SpawnPlugin {
+    fn build(&self, app: &mut App) {
+        if let Some(drop) = self.drop {
+            app.insert_resource(drop);
+        }
+        app.register_type::<SpawnConfig>()
+            .register_type::<DropConfig>()
+            .insert_resource(self.config.clone())
+            .insert_resource(FixedCircles(self.circles.clone()))
+            .init_resource::<SpawnReport>()
+            .init_resource::<Dropped>()
+            .add_message::<Respawn>()
+            .add_systems(Startup, spawn_circles.in_set(CircleSystems::Spawn))
+            .add_systems(
+                FixedUpdate,
+                drop_circles
+                    .run_if(resource_exists::<DropConfig>)
+                    .before(CircleSystems::Step),
+            )
+            .add_systems(
+                PreUpdate,
+                respawn_circles
+                    .run_if(on_message::<Respawn>)
+                    .in_set(CircleSystems::Spawn),
+            );
+    }
+}
+
+/// Spawns the [`FixedCircles`], then random circles placed from the [`SpawnConfig`] around them
+/// and clear of the [`Segments`].
+fn spawn_circles(
+    mut commands: Commands,
+    arena: Res<Arena>,
+    config: Res<SpawnConfig>,
+    around: (Res<FixedCircles>, Option<Res<Segments>>),
+    mut report: ResMut<SpawnReport>,
+) {
+    let (fixed, segments) = around;
+    let requested = config.target_count(&arena);
+    let walls = segments.as_ref().map_or(&[][..], |s| &s.0[..]);
+    let (random, refused) = match place_circles(&arena, &config, &fixed.0, walls) {
+        Ok(circles) => (circles, None),
+        Err(e) => {
+            error!("cannot spawn circles: {e}");
+            (Vec::new(), Some(e.to_string()))
+        }
+    };
+    if random.len() < requested {
+        warn!(
+            "placed {} of {requested} random circles: the arena has no room for more without overlap",
+            random.len()
+        );
+    }
+    *report = SpawnReport {
+        requested: requested + fixed.0.len(),
+        placed: random.len() + fixed.0.len(),
+        generation: report.generation + 1,
+        refused,
+    };
+    let bundles: Vec<_> = fixed
+        .0
+        .iter()
+        .chain(&random)
+        .map(CircleState::bundle)
+        .collect();
+    commands.spawn_batch(bundles);
+}
+
+/// How many circles the [`DropConfig`] has dropped since the last (re)spawn.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Dropped {
+    /// Circles dropped.
+    pub count: usize,
+    /// The [`SpawnReport::generation`] the count belongs to.
+    pub generation: u64,
+}
+
+/// Drops the next circle of the [`DropConfig`] when its time has come and its spot is free of
+/// circles and segment walls (else it waits for a later step).
+fn drop_circles(
+    mut commands: Commands,
+    rules: (Res<DropConfig>, Res<SpawnConfig>),
+    totals: Res<StepTotals>,
+    report: Res<SpawnReport>,
+    segments: Option<Res<Segments>>,
+    mut dropped: ResMut<Dropped>,
+    circles: Query<(&Position, &Radius)>,
+) {
+    let (config, spawn) = rules;
+    if dropped.generation != report.generation {
+        *dropped = Dropped {
+            count: 0,
+            generation: report.generation,
+        };
+    }
+    let due = dropped.count as f64 * config.every;
+    if dropped.count >= config.count || totals.sim_seconds + 1e-9 * config.every < due {
+        return;
+    }
+    // One random stream per drop: a drop that waits tries the same spot again.
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    rng.set_stream(dropped.count as u64);
+    let dx = sample_between(&mut rng, -config.spread, config.spread);
+    let (p, r) = (config.position + DVec2::new(dx, 0.0), config.radius);
+    let taken = circles
+        .iter()
+        .any(|(q, s)| p.distance_squared(q.0) < (r + s.0) * (r + s.0));
+    let walled = segments.is_some_and(|s| s.0.iter().any(|s| s.distance(p) < r));
+    if taken || walled {
+        return;
+    }
+    let circle = CircleState {
+        position: p,
+        velocity: config.velocity,
+        radius: r,
+        mass: spawn.mass.mass_of(r),
+        tint: hue_to_rgb(rng.random_range(0.0..1.0)),
+    };
+    commands.spawn(circle.bundle());
+    dropped.count += 1;
+}
+
+/// Despawns every circle and places a fresh set.
+fn respawn_circles(
+    mut commands: Commands,
+    mut requests: MessageReader<Respawn>,
+    circles: Query<Entity, With<Radius>>,
+    arena: Res<Arena>,
+    config: Res<SpawnConfig>,
+    around: (Res<FixedCircles>, Option<Res<Segments>>),
+    report: ResMut<SpawnReport>,
+) {
+    requests.clear();
+    for entity in &circles {
+        commands.entity(entity).despawn();
+    }
+    spawn_circles(commands, arena, config, around, report);
+}
