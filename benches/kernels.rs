@@ -100,6 +100,22 @@ fn spawn_lattice(c: &mut Criterion) {
     group.finish();
 }
 
+/// A `pack` placement of 1024 and 4096 equal circles to area fraction 0.85 in a periodic unit
+/// box: random spots at 0.25, then the compression under the event engine.
+fn spawn_pack(c: &mut Criterion) {
+    let mut group = c.benchmark_group("spawn_pack");
+    group.sample_size(10);
+    for n in [1024, 4096] {
+        let mut config = lattice(n, 0.85);
+        config.spawn.placement = Placement::Pack;
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| black_box(place_circles(&config.arena, &config.spawn, &[], &[])))
+        });
+    }
+    group.finish();
+}
+
 /// `n` equal circles on a lattice at area fraction `fraction` in a periodic unit box.
 fn lattice(n: usize, fraction: f64) -> CirclesConfig {
     let radius = (fraction / (n as f64 * std::f64::consts::PI)).sqrt();
@@ -175,6 +191,7 @@ criterion_group!(
     contact_pass,
     spawn,
     spawn_lattice,
+    spawn_pack,
     exact_events,
     exact_density
 );

@@ -187,7 +187,7 @@ fn the_command_line_asks_for_a_lattice_and_refuses_it_for_particle_files() {
 
     let out = run(&["--scene", scene_arg, "--placement", "hexagonal"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && stderr.contains("expected `random` or `lattice`"));
+    assert!(!out.status.success() && stderr.contains("expected `random`, `lattice` or `pack`"));
 
     let particles = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/particles/p10.txt");
     let out = run(&["--particles", particles, "--placement", "lattice"]);

@@ -39,7 +39,7 @@ fn spawned_circles_never_overlap_and_stay_inside() {
         .collect();
     assert_eq!(placed.len(), 1500, "this arena has room for all of them");
     assert_valid_placement(&config.arena, &placed);
-    let report = *app.world().resource::<SpawnReport>();
+    let report = app.world().resource::<SpawnReport>().clone();
     assert_eq!((report.requested, report.placed), (1500, 1500));
 }
 
@@ -57,7 +57,7 @@ fn an_overfull_request_places_what_fits_and_reports_it() {
         ..default()
     };
     let mut app = create_app(config);
-    let report = *app.world().resource::<SpawnReport>();
+    let report = app.world().resource::<SpawnReport>().clone();
     assert_eq!(report.requested, 5000);
     assert!(
         report.placed > 10 && report.placed < 100,

@@ -32,6 +32,8 @@ pub const MAX_STEPS: u64 = 10_000_000_000;
 /// Circles above which `run` says it is placing them before it starts (placing millions takes
 /// seconds to minutes).
 const ANNOUNCE_SPAWN_FROM: usize = 1_000_000;
+/// The same for a `pack` placement, whose compression takes about a second per 5000 circles.
+const ANNOUNCE_PACK_FROM: usize = 20_000;
 
 /// Where the circles come from.
 #[derive(Clone, Debug, PartialEq)]
@@ -159,7 +161,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             let (config, source) = configure(input, &options)?;
             let dt = config.dt;
             set_threads(options.threads);
-            let mut app = start(config);
+            let mut app = start(config)?;
             let progress = Progress::start(app.world_mut());
             (app, progress, source, dt)
         }
@@ -319,20 +321,25 @@ fn set_threads(threads: Option<u16>) {
 
 /// The headless app of `config`, its circles placed (saying so first when that takes a while,
 /// and afterwards when not all fit).
-fn start(config: CirclesConfig) -> App {
+fn start(config: CirclesConfig) -> anyhow::Result<App> {
     let placing = config.spawn.target_count(&config.arena);
-    if placing >= ANNOUNCE_SPAWN_FROM {
+    if config.spawn.placement == Placement::Pack && placing >= ANNOUNCE_PACK_FROM {
+        eprintln!("moving_circles: compressing {placing} circles (this takes a while)");
+    } else if placing >= ANNOUNCE_SPAWN_FROM {
         eprintln!("moving_circles: placing {placing} circles at random (this takes a while)");
     }
     let app = headless_app(config);
-    let spawn = *app.world().resource::<SpawnReport>();
+    let spawn = app.world().resource::<SpawnReport>();
+    if let Some(refused) = &spawn.refused {
+        bail!("cannot spawn the scene's circles: {refused}");
+    }
     if spawn.placed < spawn.requested {
         eprintln!(
             "moving_circles: warning: placed {} of {} circles; the arena has no room for more",
             spawn.placed, spawn.requested
         );
     }
-    app
+    Ok(app)
 }
 
 /// Refuses, before any work, outputs that could not be written or would clobber something:

@@ -88,7 +88,8 @@ pub struct SpawnConfig {
     pub mass: MassModel,
     /// Placement attempts per circle before it is given up as not fitting.
     pub attempts_per_circle: u32,
-    /// Random spots, or the sites of a triangular lattice (dense states).
+    /// Random spots, the sites of a triangular lattice, or random spots compressed (the last
+    /// two for dense states).
     pub placement: Placement,
 }
 
@@ -104,6 +105,12 @@ pub enum Placement {
     /// sites than circles), for equal radii: any area fraction up to the lattice's densest
     /// (about 0.88 in a square box). Velocities are random, so the crystal melts when run.
     Lattice,
+    /// Random spots at a quarter of the area (or less), then a Lubachevsky–Stillinger
+    /// compression under the event engine grows the circles to their radii: any radii, any area
+    /// fraction a compression reaches before it jams (0.85 for equal disks, polycrystalline). A
+    /// scene's fixed circles and segment walls are not compressed, so they cannot be packed
+    /// around.
+    Pack,
 }
 
 impl FromStr for Placement {
@@ -113,8 +120,9 @@ impl FromStr for Placement {
         match s {
             "random" => Ok(Self::Random),
             "lattice" => Ok(Self::Lattice),
+            "pack" => Ok(Self::Pack),
             other => Err(format!(
-                "unknown placement `{other}`: expected `random` or `lattice`"
+                "unknown placement `{other}`: expected `random`, `lattice` or `pack`"
             )),
         }
     }

@@ -11,6 +11,7 @@
 //! into the engine (rebuilding it if needed), advance it by the step, write the circles back.
 
 pub mod engine;
+pub mod pack;
 pub mod queue;
 pub mod toi;
 

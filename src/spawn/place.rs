@@ -1,6 +1,5 @@
-//! Seeded, non-overlapping placement of circles ([`place_circles`], a plain function over
-//! plain data) and [`SpawnPlugin`], which spawns them at startup and on [`Respawn`] requests,
-//! and drops circles in one at a time while the simulation runs ([`DropConfig`]).
+//! Seeded, non-overlapping placement of circles: random spots, the sites of a triangular
+//! lattice, or random spots compressed (`pack`).
 //!
 //! Placement is rejection sampling against a uniform [`Grid`] of the circles already placed, so
 //! each attempt checks a 3×3 block of cells instead of every circle: 100k circles place in well
@@ -8,22 +7,17 @@
 //! is full the remaining circles are skipped and the shortfall is reported, never looped on.
 
 use bevy::math::DVec2;
-use bevy::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::{Deserialize, Serialize};
 
 use crate::arena::Arena;
 use crate::circle::CircleState;
-use crate::components::Position;
-use crate::components::Radius;
-use crate::config::{DropConfig, Placement, SpawnConfig};
+use crate::config::{Placement, SpawnConfig};
 use crate::error::FieldError;
+use crate::exact::pack::{PACK_START_FRACTION, compress};
 use crate::grid::{CellMembers, Grid};
 use crate::lattice::lattice_sites;
-use crate::schedule::CircleSystems;
-use crate::schedule::StepTotals;
-use crate::segment::{Segment, SegmentCells, Segments};
+use crate::segment::{Segment, SegmentCells};
 
 /// Places up to [`SpawnConfig::target_count`] non-overlapping circles inside `arena`, largest
 /// first, around the `fixed` circles already there (which are not returned) and clear of the
@@ -60,6 +54,11 @@ pub fn place_circles(
         .map(|_| rng.random_range(r_min..=r_max))
         .collect();
     radii.sort_by(|a, b| b.total_cmp(a));
+    // A compression places the circles shrunk by `loose` first, then grows them back.
+    let loose = match config.placement {
+        Placement::Pack => pack_start(arena, &radii, fixed, segments)?,
+        _ => 1.0,
+    };
 
     // Fixed circles can be larger than any random one; the grid's cells must span the largest.
     let largest = fixed.iter().map(|c| c.radius).fold(r_max, f64::max);
@@ -71,7 +70,7 @@ pub fn place_circles(
         placed.push(*circle);
     }
     let mut sites = match config.placement {
-        Placement::Random => Vec::new(),
+        Placement::Random | Placement::Pack => Vec::new(),
         Placement::Lattice => {
             // The check above made sure the lattice fits.
             let sites = lattice_sites(arena.min, arena.size(), arena.is_periodic(), count, r_min)
@@ -84,7 +83,10 @@ pub fn place_circles(
         }
     }
     .into_iter();
-    for r in radii {
+    // The radii of the circles placed, in order.
+    let mut drawn = Vec::with_capacity(count);
+    for grown in radii {
+        let r = grown * loose;
         let lo = arena.min + DVec2::splat(r);
         let hi = arena.max - DVec2::splat(r);
         if lo.x > hi.x || lo.y > hi.y {
@@ -94,7 +96,7 @@ pub fn place_circles(
             !grid.overlaps_any(*p, r, &placed) && walls.first_touched(segments, *p, r).is_none()
         };
         let spot = match config.placement {
-            Placement::Random => (0..config.attempts_per_circle)
+            Placement::Random | Placement::Pack => (0..config.attempts_per_circle)
                 .map(|_| {
                     DVec2::new(
                         sample_between(&mut rng, lo.x, hi.x),
@@ -109,15 +111,19 @@ pub fn place_circles(
         let speed = sample_between(&mut rng, s_min, s_max);
         let angle = rng.random_range(0.0..std::f64::consts::TAU);
         grid.insert(position, placed.len());
+        drawn.push(grown);
         placed.push(CircleState {
             position,
             velocity: DVec2::from_angle(angle) * speed,
             radius: r,
-            mass: config.mass.mass_of(r),
+            mass: config.mass.mass_of(grown),
             tint: hue_to_rgb(rng.random_range(0.0..1.0)),
         });
     }
     let mut random = placed.split_off(fixed.len());
+    if loose < 1.0 {
+        random = grow_back(arena, config, &random, &drawn, loose)?;
+    }
     // Spawn in row-major cell order, so circles near each other in space are near each other in
     // memory: the collision pass then walks its arrays mostly in order (at 1M circles this is the
     // difference between cache hits and misses; see the README's performance section).
@@ -128,7 +134,58 @@ pub fn place_circles(
     Ok(random)
 }
 
-fn sample_between(rng: &mut impl Rng, lo: f64, hi: f64) -> f64 {
+/// How much a `pack` placement shrinks circles of these `radii` to place them at
+/// [`PACK_START_FRACTION`] of the area at most, or why it cannot pack around what is there.
+fn pack_start(
+    arena: &Arena,
+    radii: &[f64],
+    fixed: &[CircleState],
+    segments: &[Segment],
+) -> Result<f64, FieldError> {
+    if !fixed.is_empty() || !segments.is_empty() {
+        return Err(FieldError::new(
+            "placement",
+            "`pack` compresses the spawned circles alone and would press them into the scene's \
+             fixed circles and segment walls: use `random` or `lattice` with those",
+        )
+        .within("spawn"));
+    }
+    let fraction = radii.iter().map(|r| r * r).sum::<f64>() * std::f64::consts::PI / arena.area();
+    Ok((PACK_START_FRACTION / fraction).sqrt().min(1.0))
+}
+
+/// The `loose` circles grown back to their `radii` by a compression, each keeping its speed in
+/// the direction the compression left it moving. A jammed compression is an error naming what was asked for.
+fn grow_back(
+    arena: &Arena,
+    config: &SpawnConfig,
+    loose: &[CircleState],
+    radii: &[f64],
+    shrunk: f64,
+) -> Result<Vec<CircleState>, FieldError> {
+    let mut packed = compress(loose, arena, 1.0 / shrunk).map_err(|jam| {
+        let field = match config.area_fraction {
+            Some(_) => "area_fraction",
+            None => "count",
+        };
+        FieldError::new(
+            field,
+            format!(
+                "a compression to area fraction {:.4} jammed at {:.4}: ask for fewer or smaller \
+                 circles",
+                jam.target, jam.reached
+            ),
+        )
+        .within("spawn")
+    })?;
+    // The radii drawn, not the shrunk ones grown back (which can differ by rounding).
+    for (c, &r) in packed.iter_mut().zip(radii) {
+        c.radius = r;
+    }
+    Ok(packed)
+}
+
+pub(super) fn sample_between(rng: &mut impl Rng, lo: f64, hi: f64) -> f64 {
     if lo < hi {
         rng.random_range(lo..=hi)
     } else {
@@ -137,7 +194,7 @@ fn sample_between(rng: &mut impl Rng, lo: f64, hi: f64) -> f64 {
 }
 
 /// A bright, saturated colour of the given hue in [0, 1).
-fn hue_to_rgb(hue: f64) -> [u8; 3] {
+pub(super) fn hue_to_rgb(hue: f64) -> [u8; 3] {
     let h = hue * 6.0;
     let x = 1.0 - (h % 2.0 - 1.0).abs();
     let (r, g, b) = match h as u32 {
@@ -197,176 +254,6 @@ impl PlacementGrid {
     }
 }
 
-/// Asks for all circles to be replaced by a fresh placement from the current [`SpawnConfig`]
-/// (after changing its `count`, say). Handled in `PreUpdate`, so it works while paused.
-#[derive(Message, Clone, Copy, Debug, Default)]
-pub struct Respawn;
-
-/// How the last placement went: what was asked for and what fit.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SpawnReport {
-    /// Circles requested.
-    pub requested: usize,
-    /// Circles placed.
-    pub placed: usize,
-    /// Increases with every placement, so observers can tell a reset happened.
-    pub generation: u64,
-}
-
-/// Circles a scene places exactly, before the random ones.
-#[derive(Resource, Clone, Debug, Default, PartialEq)]
-pub struct FixedCircles(pub Vec<CircleState>);
-
-/// Spawns the [`FixedCircles`] and random circles from a [`SpawnConfig`] at startup and on
-/// every [`Respawn`].
-#[derive(Clone, Debug, Default)]
-pub struct SpawnPlugin {
-    /// Random circles to place.
-    pub config: SpawnConfig,
-    /// Circles to place exactly as given.
-    pub circles: Vec<CircleState>,
-    /// Circles to drop in one at a time while it runs.
-    pub drop: Option<DropConfig>,
-}
-
-impl Plugin for SpawnPlugin {
-    fn build(&self, app: &mut App) {
-        if let Some(drop) = self.drop {
-            app.insert_resource(drop);
-        }
-        app.register_type::<SpawnConfig>()
-            .register_type::<DropConfig>()
-            .insert_resource(self.config.clone())
-            .insert_resource(FixedCircles(self.circles.clone()))
-            .init_resource::<SpawnReport>()
-            .init_resource::<Dropped>()
-            .add_message::<Respawn>()
-            .add_systems(Startup, spawn_circles.in_set(CircleSystems::Spawn))
-            .add_systems(
-                FixedUpdate,
-                drop_circles
-                    .run_if(resource_exists::<DropConfig>)
-                    .before(CircleSystems::Step),
-            )
-            .add_systems(
-                PreUpdate,
-                respawn_circles
-                    .run_if(on_message::<Respawn>)
-                    .in_set(CircleSystems::Spawn),
-            );
-    }
-}
-
-/// Spawns the [`FixedCircles`], then random circles placed from the [`SpawnConfig`] around them
-/// and clear of the [`Segments`].
-fn spawn_circles(
-    mut commands: Commands,
-    arena: Res<Arena>,
-    config: Res<SpawnConfig>,
-    around: (Res<FixedCircles>, Option<Res<Segments>>),
-    mut report: ResMut<SpawnReport>,
-) {
-    let (fixed, segments) = around;
-    let requested = config.target_count(&arena);
-    let walls = segments.as_ref().map_or(&[][..], |s| &s.0[..]);
-    let random = match place_circles(&arena, &config, &fixed.0, walls) {
-        Ok(circles) => circles,
-        Err(e) => {
-            error!("cannot spawn circles: {e}");
-            Vec::new()
-        }
-    };
-    if random.len() < requested {
-        warn!(
-            "placed {} of {requested} random circles: the arena has no room for more without overlap",
-            random.len()
-        );
-    }
-    *report = SpawnReport {
-        requested: requested + fixed.0.len(),
-        placed: random.len() + fixed.0.len(),
-        generation: report.generation + 1,
-    };
-    let bundles: Vec<_> = fixed
-        .0
-        .iter()
-        .chain(&random)
-        .map(CircleState::bundle)
-        .collect();
-    commands.spawn_batch(bundles);
-}
-
-/// How many circles the [`DropConfig`] has dropped since the last (re)spawn.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Dropped {
-    /// Circles dropped.
-    pub count: usize,
-    /// The [`SpawnReport::generation`] the count belongs to.
-    pub generation: u64,
-}
-
-/// Drops the next circle of the [`DropConfig`] when its time has come and its spot is free of
-/// circles and segment walls (else it waits for a later step).
-fn drop_circles(
-    mut commands: Commands,
-    rules: (Res<DropConfig>, Res<SpawnConfig>),
-    totals: Res<StepTotals>,
-    report: Res<SpawnReport>,
-    segments: Option<Res<Segments>>,
-    mut dropped: ResMut<Dropped>,
-    circles: Query<(&Position, &Radius)>,
-) {
-    let (config, spawn) = rules;
-    if dropped.generation != report.generation {
-        *dropped = Dropped {
-            count: 0,
-            generation: report.generation,
-        };
-    }
-    let due = dropped.count as f64 * config.every;
-    if dropped.count >= config.count || totals.sim_seconds + 1e-9 * config.every < due {
-        return;
-    }
-    // One random stream per drop: a drop that waits tries the same spot again.
-    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
-    rng.set_stream(dropped.count as u64);
-    let dx = sample_between(&mut rng, -config.spread, config.spread);
-    let (p, r) = (config.position + DVec2::new(dx, 0.0), config.radius);
-    let taken = circles
-        .iter()
-        .any(|(q, s)| p.distance_squared(q.0) < (r + s.0) * (r + s.0));
-    let walled = segments.is_some_and(|s| s.0.iter().any(|s| s.distance(p) < r));
-    if taken || walled {
-        return;
-    }
-    let circle = CircleState {
-        position: p,
-        velocity: config.velocity,
-        radius: r,
-        mass: spawn.mass.mass_of(r),
-        tint: hue_to_rgb(rng.random_range(0.0..1.0)),
-    };
-    commands.spawn(circle.bundle());
-    dropped.count += 1;
-}
-
-/// Despawns every circle and places a fresh set.
-fn respawn_circles(
-    mut commands: Commands,
-    mut requests: MessageReader<Respawn>,
-    circles: Query<Entity, With<Radius>>,
-    arena: Res<Arena>,
-    config: Res<SpawnConfig>,
-    around: (Res<FixedCircles>, Option<Res<Segments>>),
-    report: ResMut<SpawnReport>,
-) {
-    requests.clear();
-    for entity in &circles {
-        commands.entity(entity).despawn();
-    }
-    spawn_circles(commands, arena, config, around, report);
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -377,7 +264,7 @@ mod tests {
         let config = SpawnConfig {
             count: 1000,
             radius: (0.3, 0.3),
-            ..default()
+            ..Default::default()
         };
         let circles = place_circles(&arena, &config, &[], &[]).unwrap();
         // A 2×2 box holds at most 9 circles of radius 0.3 (3 per row at spacing 0.6 + walls).
@@ -394,7 +281,7 @@ mod tests {
         let config = SpawnConfig {
             count: 3,
             radius: (0.6, 0.6),
-            ..default()
+            ..Default::default()
         };
         assert!(place_circles(&arena, &config, &[], &[]).unwrap().is_empty());
     }
@@ -404,13 +291,13 @@ mod tests {
         let arena = Arena::default();
         let bad_radius = SpawnConfig {
             radius: (0.5, 0.1),
-            ..default()
+            ..Default::default()
         };
         let err = place_circles(&arena, &bad_radius, &[], &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.radius"), "{err}");
         let bad_speed = SpawnConfig {
             speed: (f64::NAN, 1.0),
-            ..default()
+            ..Default::default()
         };
         let err = place_circles(&arena, &bad_speed, &[], &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.speed"), "{err}");
