@@ -168,6 +168,48 @@ fn exact_density(c: &mut Criterion) {
     group.finish();
 }
 
+/// Pair collisions per second of the event engine on `wide_radii.ron` (20 000 circles of radii
+/// 1e-4…1e-3 and two of 0.1 and 0.05, walls) against the same count of equal circles (radius
+/// 5.5e-4) without the two: the large circles stay out of the cells, so the cost per collision
+/// should be about the same. Each iteration runs until 5000 more pair collisions have happened
+/// (in steps of 0.002 time units, its time scaled to exactly 5000), after one time unit of
+/// warm-up, so that a collision rate that drifts as the gas relaxes does not skew the count.
+fn exact_wide_radii(c: &mut Criterion) {
+    let mut group = c.benchmark_group("exact_wide_radii");
+    group.sample_size(10);
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/wide_radii.ron");
+    let wide = Scene::load(std::path::Path::new(path)).expect("the scene loads");
+    let mut uniform = wide.clone();
+    uniform.circles.clear();
+    uniform.spawn.radius = (5.5e-4, 5.5e-4);
+    const BATCH: u64 = 5000;
+    group.throughput(Throughput::Elements(BATCH));
+    for (name, config) in [("uniform", uniform), ("wide", wide)] {
+        let mut circles = config.circles.clone();
+        let placed = place_circles(&config.arena, &config.spawn, &config.circles, &[]);
+        circles.extend(placed.expect("fits"));
+        let mut engine = EventEngine::new(&circles, &config.arena, &[], 1.0, 1.0);
+        engine.advance_to(1.0, u64::MAX).expect("no budget");
+        group.bench_function(name, |b| {
+            b.iter_custom(|iterations| {
+                let mut elapsed = std::time::Duration::ZERO;
+                for _ in 0..iterations {
+                    let before = engine.stats().pair_collisions;
+                    let start = std::time::Instant::now();
+                    while engine.stats().pair_collisions - before < BATCH {
+                        let next = engine.now() + 0.002;
+                        black_box(engine.advance_to(next, u64::MAX)).expect("no budget");
+                    }
+                    let done = engine.stats().pair_collisions - before;
+                    elapsed += start.elapsed().mul_f64(BATCH as f64 / done as f64);
+                }
+                elapsed
+            })
+        });
+    }
+    group.finish();
+}
+
 fn exact_events(c: &mut Criterion) {
     let mut group = c.benchmark_group("exact_events");
     group.sample_size(10);
@@ -193,6 +235,7 @@ criterion_group!(
     spawn_lattice,
     spawn_pack,
     exact_events,
-    exact_density
+    exact_density,
+    exact_wide_radii
 );
 criterion_main!(benches);

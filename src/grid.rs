@@ -198,13 +198,14 @@ impl CellMembers {
     }
 
     /// Whether these lists hold each of `circles` circles exactly once, in `cells` cells, circle
-    /// `i` in cell `cell_of(i)`, with every link consistent: what lists read from outside (a
-    /// checkpoint) must show before anything walks them. Says what is wrong.
+    /// `i` in cell `cell_of(i)` (in none where that is `None`), with every link consistent: what
+    /// lists read from outside (a checkpoint) must show before anything walks them. Says what is
+    /// wrong.
     pub fn check(
         &self,
         cells: usize,
         circles: usize,
-        cell_of: impl Fn(usize) -> usize,
+        cell_of: impl Fn(usize) -> Option<usize>,
     ) -> Result<(), String> {
         if self.head.len() != cells || self.next.len() != circles || self.prev.len() != circles {
             return Err(format!(
@@ -218,14 +219,14 @@ impl CellMembers {
             let (mut at, mut before) = (head, NONE);
             while at != NONE {
                 let i = at as usize;
-                if i >= circles || seen[i] || self.prev[i] != before || cell_of(i) != cell {
+                if i >= circles || seen[i] || self.prev[i] != before || cell_of(i) != Some(cell) {
                     return Err(format!("cell {cell}'s list is broken at circle {at}"));
                 }
                 seen[i] = true;
                 (before, at) = (at, self.next[i]);
             }
         }
-        match seen.iter().position(|&s| !s) {
+        match (0..circles).find(|&i| !seen[i] && cell_of(i).is_some()) {
             Some(i) => Err(format!("circle {i} is in no cell list")),
             None => Ok(()),
         }

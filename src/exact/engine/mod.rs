@@ -17,6 +17,7 @@
 
 mod events;
 mod growth;
+mod large;
 mod predict;
 mod snapshot;
 mod walls;
@@ -25,7 +26,7 @@ pub use events::{BudgetExhausted, EventStats};
 pub use snapshot::EngineSnapshot;
 
 use events::{BestPair, Event, Kind, Motion, NO_PAIR};
-use walls::{cell_width, walls_inside};
+use walls::{Layout, cell_width, walls_inside};
 
 use bevy::math::DVec2;
 
@@ -88,6 +89,10 @@ pub struct EventEngine {
     /// How fast radii grow: circle `i`'s radius is `radius·(1 + growth·t)`. 0 but in a
     /// compression ([`EventEngine::growing`]).
     growth: f64,
+    /// The few circles too large for the cells, in no cell list, and how many cells around its
+    /// own each looks at.
+    large: Vec<u32>,
+    reach: Vec<u32>,
 }
 
 impl EventEngine {
@@ -122,7 +127,13 @@ impl EventEngine {
     ) -> Self {
         let n = circles.len();
         let size = arena.size();
-        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments, width);
+        let Layout {
+            grid,
+            segments,
+            segment_cells,
+            large,
+            reach,
+        } = walls_inside(arena, circles, segments, width);
         let mut engine = Self {
             arena: *arena,
             period: size,
@@ -164,6 +175,8 @@ impl EventEngine {
             own_restitution: Vec::new(),
             hits: None,
             growth: 0.0,
+            large,
+            reach,
         };
         engine.relink_all();
         engine.predict_all();
@@ -201,10 +214,15 @@ impl EventEngine {
         self.motion[i].vel = velocity;
         self.motion[i].t_at = self.now;
         self.counter[i] += 1;
-        self.cells.remove(i, self.cell_index(i));
+        let listed = self.large_reach(i).is_none();
+        if listed {
+            self.cells.remove(i, self.cell_index(i));
+        }
         let (x, y) = self.grid.cell_of(position);
         (self.cell_x[i], self.cell_y[i]) = (x as u32, y as u32);
-        self.cells.insert(i, self.grid.index(x, y));
+        if listed {
+            self.cells.insert(i, self.grid.index(x, y));
+        }
         self.predict(i);
     }
 
@@ -344,14 +362,17 @@ impl EventEngine {
             .index(self.cell_x[i] as usize, self.cell_y[i] as usize)
     }
 
-    /// Puts every circle in the cell its current position lies in.
+    /// Puts every circle in the cell its current position lies in (large circles in none, but
+    /// each still knows its cell).
     fn relink_all(&mut self) {
         self.cells.clear();
         for i in 0..self.len() {
             let (x, y) = self.grid.cell_of(self.motion[i].pos);
             self.cell_x[i] = x as u32;
             self.cell_y[i] = y as u32;
-            self.cells.insert(i, self.grid.index(x, y));
+            if self.large_reach(i).is_none() {
+                self.cells.insert(i, self.grid.index(x, y));
+            }
         }
     }
 
@@ -401,7 +422,10 @@ impl EventEngine {
     /// Moves circle `i` into the next cell along `axis` (past a periodic edge, the first cell
     /// on the other side). Its course is unchanged, so its motion is left as it is.
     fn cross_cell(&mut self, i: usize, axis: usize, up: bool) {
-        self.cells.remove(i, self.cell_index(i));
+        let listed = self.large_reach(i).is_none();
+        if listed {
+            self.cells.remove(i, self.cell_index(i));
+        }
         let (count, cell) = if axis == 0 {
             (self.grid.cols as u32, &mut self.cell_x[i])
         } else {
@@ -412,7 +436,9 @@ impl EventEngine {
         } else {
             (*cell + count - 1) % count
         };
-        self.cells.insert(i, self.cell_index(i));
+        if listed {
+            self.cells.insert(i, self.cell_index(i));
+        }
         self.predict_after_crossing(i, axis, up);
     }
 }

@@ -9,70 +9,85 @@
 use bevy::math::DVec2;
 
 use super::EventEngine;
-use super::events::{BestPair, Event, Kind, NO_PAIR};
+use super::events::{BestPair, Event, Kind, Motion, NO_PAIR};
 use crate::exact::toi::{
     growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact, wall_time_of_impact,
 };
 use crate::grid::NONE;
 
 impl EventEngine {
-    /// The soonest collision of circle `i` with a circle in `cells`, not before now.
-    ///
-    /// A pair's time is worked out from the later of its two last changes of course, not from
-    /// now, so it depends on the two motions alone: when the pair is looked at (after which
-    /// cell crossing) cannot change it, and the cell grid does not change the trajectories.
-    fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
-        let now = self.now;
+    /// The soonest collision of circle `i` with a circle in `cells` or a large circle, not
+    /// before now.
+    pub(super) fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
         let me = self.motion[i];
         let mut best = NO_PAIR;
         for c in cells {
             for j in self.cells.members(c) {
-                if j == i {
-                    continue;
+                if j != i {
+                    self.look_at(&me, j, &mut best);
                 }
-                let other = &self.motion[j];
-                // At the later reference time one of the two is at its reference point.
-                let (since, mut dp) = if me.t_at >= other.t_at {
-                    (me.t_at, other.at(me.t_at) - me.pos)
-                } else {
-                    (other.t_at, other.pos - me.at(other.t_at))
-                };
-                let dv = other.vel - me.vel;
-                if self.grid.periodic {
-                    // Through the image the pair is nearest in now: they may have flown far
-                    // since `since`.
-                    let d = dp + dv * (now - since);
-                    dp.x -= whole_periods(d.x, self.period.x);
-                    dp.y -= whole_periods(d.y, self.period.y);
-                }
-                let sum = me.radius + other.radius;
-                let impact = if self.growth == 0.0 {
-                    pair_time_of_impact(dp, dv, sum)
-                } else {
-                    growing_pair_time_of_impact(
-                        dp,
-                        dv,
-                        sum * (1.0 + self.growth * since),
-                        sum * self.growth,
-                    )
-                };
-                if let Some(t) = impact
-                    && (since + t).max(now) < best.time
-                {
-                    best = BestPair {
-                        time: (since + t).max(now),
-                        partner: j as u32,
-                        partner_count: self.counter[j],
-                    };
-                }
+            }
+        }
+        for &j in &self.large {
+            if j as usize != i {
+                self.look_at(&me, j as usize, &mut best);
             }
         }
         best
     }
 
+    /// Keeps in `best` the sooner of it and the collision of the circle moving as `me` with
+    /// circle `j`, if they collide.
+    ///
+    /// A pair's time is worked out from the later of its two last changes of course, not from
+    /// now, so it depends on the two motions alone: when the pair is looked at (after which
+    /// cell crossing) cannot change it, and the cell grid does not change the trajectories.
+    #[inline(always)]
+    fn look_at(&self, me: &Motion, j: usize, best: &mut BestPair) {
+        let now = self.now;
+        let other = &self.motion[j];
+        // At the later reference time one of the two is at its reference point.
+        let (since, mut dp) = if me.t_at >= other.t_at {
+            (me.t_at, other.at(me.t_at) - me.pos)
+        } else {
+            (other.t_at, other.pos - me.at(other.t_at))
+        };
+        let dv = other.vel - me.vel;
+        if self.grid.periodic {
+            // Through the image the pair is nearest in now: they may have flown far since
+            // `since`.
+            let d = dp + dv * (now - since);
+            dp.x -= whole_periods(d.x, self.period.x);
+            dp.y -= whole_periods(d.y, self.period.y);
+        }
+        let sum = me.radius + other.radius;
+        let impact = if self.growth == 0.0 {
+            pair_time_of_impact(dp, dv, sum)
+        } else {
+            growing_pair_time_of_impact(
+                dp,
+                dv,
+                sum * (1.0 + self.growth * since),
+                sum * self.growth,
+            )
+        };
+        if let Some(t) = impact
+            && (since + t).max(now) < best.time
+        {
+            *best = BestPair {
+                time: (since + t).max(now),
+                partner: j as u32,
+                partner_count: self.counter[j],
+            };
+        }
+    }
+
     /// Looks at every circle in the 3×3 block of cells around circle `i` and schedules its
     /// soonest event.
     pub(super) fn predict(&mut self, i: usize) {
+        if let Some(reach) = self.large_reach(i) {
+            return self.predict_large(i, reach);
+        }
         let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
         let (cols, rows) = (self.grid.cols, self.grid.rows);
         self.best_pair[i] = if (1..cols - 1).contains(&x) && (1..rows - 1).contains(&y) {
@@ -95,6 +110,9 @@ impl EventEngine {
     /// it comes up and the circle looks at all its neighbours then, before anything it could
     /// have missed.
     pub(super) fn predict_after_crossing(&mut self, i: usize, axis: usize, up: bool) {
+        if let Some(reach) = self.large_reach(i) {
+            return self.large_after_crossing(i, axis, up, reach);
+        }
         let best = self.best_pair[i];
         let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
         let ahead = if up { 1 } else { -1 };
@@ -116,7 +134,7 @@ impl EventEngine {
     /// Sets circle `i`'s event to the soonest of its best pair, a wall hit, a hit on a segment
     /// wall listed in its cell and a cell crossing. Like pair times, these are worked out from
     /// the circle's last change of course (`t_at`), never from now, and are never before now.
-    fn schedule(&mut self, i: usize) {
+    pub(super) fn schedule(&mut self, i: usize) {
         let m = self.motion[i];
         let (p, since, now) = (m.pos, m.t_at, self.now);
         let best = self.best_pair[i];

@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::events::{BestPair, Event, EventStats, Kind, Motion};
-use super::{EventEngine, cell_width, walls_inside};
+use super::{EventEngine, Layout, cell_width, walls_inside};
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::exact::queue::EventQueue;
@@ -79,7 +79,13 @@ impl EventEngine {
         }
         let size = arena.size();
         let width = cell_width(arena, circles);
-        let (grid, segments, segment_cells) = walls_inside(arena, circles, segments, width);
+        let Layout {
+            grid,
+            segments,
+            segment_cells,
+            large,
+            reach,
+        } = walls_inside(arena, circles, segments, width);
         let partner_ok = |p: u32, i: usize| p == NONE || (p as usize) < n && p as usize != i;
         for (i, c) in circles.iter().enumerate() {
             let m = &s.motion[i];
@@ -107,7 +113,11 @@ impl EventEngine {
                 return Err(format!("engine state of circle {i} is inconsistent"));
             }
         }
-        let cell_of = |i: usize| grid.index(s.cell_x[i] as usize, s.cell_y[i] as usize);
+        // Large circles are in no cell list.
+        let cell_of = |i: usize| {
+            let cell = grid.index(s.cell_x[i] as usize, s.cell_y[i] as usize);
+            (!large.contains(&(i as u32))).then_some(cell)
+        };
         s.cells.check(grid.len(), n, cell_of)?;
         Ok(Self {
             arena: *arena,
@@ -131,6 +141,8 @@ impl EventEngine {
             own_restitution: Vec::new(),
             hits: None,
             growth: 0.0,
+            large,
+            reach,
         })
     }
 }

@@ -5,6 +5,7 @@
 use std::f64::consts::PI;
 
 use super::EventEngine;
+use super::large::{large_circles, reach};
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::collide::contact::combine_restitution;
@@ -109,34 +110,56 @@ impl EventEngine {
     }
 }
 
-/// The engine's grid (cells at least `width` and one largest diameter wide, about four per
-/// circle or segment at most) and the segment walls it keeps, listed in the cells they pass
-/// within a largest radius of (none on a periodic arena).
+/// Where the engine keeps its circles and walls: the grid, the segment walls (none on a periodic
+/// arena) and the cells they pass near, and the circles too large for the cells with how far
+/// each reaches.
+pub(super) struct Layout {
+    pub(super) grid: Grid,
+    pub(super) segments: Vec<Segment>,
+    pub(super) segment_cells: SegmentCells,
+    pub(super) large: Vec<u32>,
+    pub(super) reach: Vec<u32>,
+}
+
+/// The engine's [`Layout`]: cells at least `width` wide, and one diameter of every circle in
+/// them (all but a few [`large_circles`] far wider than `width`), about four per circle or
+/// segment at most; segment walls listed in the cells they pass within a largest radius of.
 pub(super) fn walls_inside(
     arena: &Arena,
     circles: &[CircleState],
     segments: &[Segment],
     width: f64,
-) -> (Grid, Vec<Segment>, SegmentCells) {
+) -> Layout {
     let segments = if arena.is_periodic() {
         &[][..]
     } else {
         segments
     };
     let largest = circles.iter().map(|c| c.radius).fold(0.0f64, f64::max);
+    let (large, in_cells) = large_circles(circles, width);
     let cap = circles.len() + segments.len();
     let grid = Grid::tiling(
         arena.min,
         arena.size(),
-        width.max(2.0 * largest),
+        width.max(2.0 * in_cells),
         cap,
         arena.is_periodic(),
     );
     // A little more than the largest radius, so a centre on a cell's edge by rounding still
     // finds the walls it touches.
     let margin = largest + 1e-9 * grid.cell.max_element();
-    let cells = SegmentCells::build(segments, grid, margin);
-    (grid, segments.to_vec(), cells)
+    let segment_cells = SegmentCells::build(segments, grid, margin);
+    let reach = large
+        .iter()
+        .map(|&i| reach(&grid, circles[i as usize].radius, in_cells))
+        .collect();
+    Layout {
+        grid,
+        segments: segments.to_vec(),
+        segment_cells,
+        large,
+        reach,
+    }
 }
 
 /// What a cell crossing costs (moving between cell lists, one more event in the queue) and what
