@@ -120,6 +120,12 @@ impl Arena {
         s.x * s.y
     }
 
+    /// The fraction of the arena's area that circles of these radii cover (overlaps counted
+    /// twice).
+    pub fn area_fraction(&self, radii: impl IntoIterator<Item = f64>) -> f64 {
+        radii.into_iter().map(|r| r * r).sum::<f64>() * std::f64::consts::PI / self.area()
+    }
+
     /// Centre of the arena.
     pub fn center(&self) -> DVec2 {
         (self.min + self.max) / 2.0

@@ -4,39 +4,18 @@
 
 mod common;
 
-use std::f64::consts::PI;
 use std::process::Command;
 
 use bevy::math::DVec2;
-use common::{create_app, energy_momentum, scene_app, step};
+use common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use moving_circles::circle::{discs, snapshot};
 use moving_circles::collide::overlaps::Overlaps;
 use moving_circles::prelude::*;
 use moving_circles::spawn::place_circles;
 
-/// A periodic unit box asked for `fraction` of circles of radius `r` on a lattice.
+/// A unit box asked for `fraction` of circles of radius `r` on a lattice.
 fn lattice_config(fraction: f64, r: f64, boundary: Boundary) -> CirclesConfig {
-    CirclesConfig {
-        arena: Arena::unit_square(boundary),
-        spawn: SpawnConfig {
-            area_fraction: Some(fraction),
-            radius: (r, r),
-            speed: (1.0, 1.0),
-            placement: Placement::Lattice,
-            ..SpawnConfig::default()
-        },
-        solver: Solver::Exact,
-        dt: 0.01,
-        ..CirclesConfig::default()
-    }
-}
-
-fn area_fraction(circles: &[CircleState], arena: &Arena) -> f64 {
-    circles
-        .iter()
-        .map(|c| PI * c.radius * c.radius)
-        .sum::<f64>()
-        / arena.area()
+    dense_config(fraction, (r, r), boundary, Placement::Lattice)
 }
 
 #[test]

@@ -253,11 +253,9 @@ fn newtons_cradle() {
 #[test]
 fn a_jammed_packing_above_080() {
     let config = load("jammed.txt");
-    let fraction: f64 = config
-        .circles
-        .iter()
-        .map(|c| std::f64::consts::PI * c.radius * c.radius)
-        .sum();
+    let fraction = config
+        .arena
+        .area_fraction(config.circles.iter().map(|c| c.radius));
     assert!(fraction > 0.8, "area fraction {fraction}");
     suite("jammed.txt", 60);
 }

@@ -4,11 +4,10 @@
 
 mod common;
 
-use std::f64::consts::PI;
 use std::process::Command;
 
 use bevy::math::DVec2;
-use common::{create_app, energy_momentum, scene_app, step};
+use common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use moving_circles::circle::{discs, snapshot};
 use moving_circles::collide::overlaps::Overlaps;
 use moving_circles::prelude::*;
@@ -16,28 +15,7 @@ use moving_circles::spawn::place_circles;
 
 /// A unit box asked for `fraction` of circles of radii `radius`, compressed.
 fn pack_config(fraction: f64, radius: (f64, f64), boundary: Boundary) -> CirclesConfig {
-    CirclesConfig {
-        arena: Arena::unit_square(boundary),
-        spawn: SpawnConfig {
-            area_fraction: Some(fraction),
-            radius,
-            speed: (0.5, 2.0),
-            placement: Placement::Pack,
-            seed: 3,
-            ..SpawnConfig::default()
-        },
-        solver: Solver::Exact,
-        dt: 0.01,
-        ..CirclesConfig::default()
-    }
-}
-
-fn area_fraction(circles: &[CircleState], arena: &Arena) -> f64 {
-    circles
-        .iter()
-        .map(|c| PI * c.radius * c.radius)
-        .sum::<f64>()
-        / arena.area()
+    dense_config(fraction, radius, boundary, Placement::Pack)
 }
 
 /// No two circles overlap by more than rounding, and with walls every circle is inside them.

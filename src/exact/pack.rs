@@ -65,7 +65,7 @@ pub fn compress(
     for stage in 1..=PACK_STAGES {
         let end = until * f64::from(stage) / f64::from(PACK_STAGES);
         if engine.advance_to(end, budget).is_err() {
-            let fraction = area_fraction(loose, arena);
+            let fraction = arena.area_fraction(loose.iter().map(|c| c.radius));
             let grown = |t: f64| fraction * (1.0 + PACK_GROWTH * t).powi(2);
             return Err(Jammed {
                 reached: grown(engine.now()),
@@ -89,9 +89,4 @@ pub fn compress(
             ..*c
         })
         .collect())
-}
-
-/// The fraction of `arena`'s area `circles` cover.
-pub fn area_fraction(circles: &[CircleState], arena: &Arena) -> f64 {
-    circles.iter().map(|c| c.radius * c.radius).sum::<f64>() * std::f64::consts::PI / arena.area()
 }

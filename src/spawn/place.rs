@@ -150,7 +150,7 @@ fn pack_start(
         )
         .within("spawn"));
     }
-    let fraction = radii.iter().map(|r| r * r).sum::<f64>() * std::f64::consts::PI / arena.area();
+    let fraction = arena.area_fraction(radii.iter().copied());
     Ok((PACK_START_FRACTION / fraction).sqrt().min(1.0))
 }
 

@@ -25,6 +25,34 @@ pub fn empty(config: CirclesConfig) -> CirclesConfig {
     }
 }
 
+/// A unit box asked for `fraction` of circles of radii `radius` at speed 1, placed by
+/// `placement`, run by `exact` at dt 0.01.
+pub fn dense_config(
+    fraction: f64,
+    radius: (f64, f64),
+    boundary: Boundary,
+    placement: Placement,
+) -> CirclesConfig {
+    CirclesConfig {
+        arena: Arena::unit_square(boundary),
+        spawn: SpawnConfig {
+            area_fraction: Some(fraction),
+            radius,
+            speed: (1.0, 1.0),
+            placement,
+            ..SpawnConfig::default()
+        },
+        solver: Solver::Exact,
+        dt: 0.01,
+        ..CirclesConfig::default()
+    }
+}
+
+/// The fraction of `arena` the `circles` cover.
+pub fn area_fraction(circles: &[CircleState], arena: &Arena) -> f64 {
+    arena.area_fraction(circles.iter().map(|c| c.radius))
+}
+
 /// Runs `n` fixed steps and checks the app really advanced that many.
 pub fn step(app: &mut App, n: u64) {
     let before = app.world().resource::<StepTotals>().steps;

@@ -122,6 +122,8 @@ impl EventEngine {
 #[cfg(test)]
 mod tests {
     use bevy::math::DVec2;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     use super::*;
     use crate::arena::{Arena, Boundary};
@@ -133,13 +135,8 @@ mod tests {
             CircleState::new(DVec2::new(0.3, 0.3), DVec2::new(0.2, 0.1), 0.1),
             CircleState::new(DVec2::new(0.7, 0.6), DVec2::new(-0.1, 0.3), 0.06),
         ];
-        let mut x: u64 = 11;
-        let mut next = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut next = || rng.random_range(-0.5..0.5);
         for k in 0..400 {
             let p = DVec2::new((k % 20) as f64 + 0.5, (k / 20) as f64 + 0.5) / 20.0;
             let clear = circles[..2]

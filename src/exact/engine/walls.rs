@@ -2,8 +2,6 @@
 //! inside it, at the point of the segment nearest the circle; and how the segment walls are
 //! listed in the engine's cells.
 
-use std::f64::consts::PI;
-
 use super::EventEngine;
 use super::large::{large_circles, reach};
 use crate::arena::Arena;
@@ -183,7 +181,7 @@ pub(super) fn cell_width(arena: &Arena, circles: &[CircleState]) -> f64 {
     let area = size.x * size.y;
     let spacing = (area / n).sqrt();
     let diameter = 2.0 * circles.iter().map(|c| c.radius).sum::<f64>() / n;
-    let fraction = circles.iter().map(|c| c.radius * c.radius).sum::<f64>() * PI / area;
+    let fraction = arena.area_fraction(circles.iter().map(|c| c.radius));
     let phi = fraction.min(0.8);
     let contact = (1.0 - 7.0 * phi / 16.0) / ((1.0 - phi) * (1.0 - phi));
     let collisions = COLLISION_WEIGHT * contact * diameter / spacing;
@@ -206,6 +204,8 @@ pub(super) fn cell_width(arena: &Arena, circles: &[CircleState]) -> f64 {
 #[cfg(test)]
 mod tests {
     use bevy::math::DVec2;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     use super::*;
     use crate::arena::Boundary;
@@ -214,13 +214,8 @@ mod tests {
     fn gas(n: usize, r: f64, arena: &Arena) -> Vec<CircleState> {
         let side = (n as f64).sqrt().ceil() as usize;
         let step = arena.size() / side as f64;
-        let mut x: u64 = 7;
-        let mut next = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut next = || rng.random_range(-0.5..0.5);
         (0..n)
             .map(|k| {
                 let cell = DVec2::new((k % side) as f64 + 0.5, (k / side) as f64 + 0.5);
