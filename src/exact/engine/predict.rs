@@ -1,10 +1,12 @@
 //! Prediction: a circle's soonest event among its best pair, a wall hit, a segment wall hit and
 //! a cell crossing.
 //!
-//! Whenever a trajectory changes, its owner looks at every neighbour (the 3×3 block of cells);
-//! after a cell crossing, which changes no trajectory, the crosser looks only at the three cells
-//! it newly borders and keeps its best pair from before if that partner has not changed. So
-//! whenever a pair becomes neighbours, the one that moved looks at the other.
+//! Whenever a trajectory changes, its owner looks at every neighbour (the 3×3 block of cells,
+//! and every large circle); after a cell crossing, which changes no trajectory, the crosser looks
+//! only at the three cells it newly borders (and again at every large circle) and keeps its best
+//! pair from before if that partner has not changed. So whenever a pair becomes neighbours, the
+//! one that moved looks at the other. A large circle does the same over the block of cells its
+//! radius reaches ([`super::large`]).
 
 use bevy::math::DVec2;
 
