@@ -112,6 +112,15 @@ fn a_compression_past_jamming_is_refused_saying_how_far_it_got() {
 }
 
 #[test]
+fn a_compression_of_more_circles_than_it_takes_is_refused_before_any_work() {
+    // 0.5 of a unit box in circles of radius 1e-3 is 159 155 circles: past the limit.
+    let config = pack_config(0.5, (1e-3, 1e-3), Boundary::Periodic);
+    let error = config.check().unwrap_err().to_string();
+    assert!(error.contains("spawn.count"), "{error}");
+    assert!(error.contains("at most 100000"), "{error}");
+}
+
+#[test]
 fn a_compression_around_fixed_circles_or_segment_walls_is_refused() {
     let config = pack_config(0.5, (0.02, 0.02), Boundary::Walls);
     let fixed = [CircleState::new(DVec2::splat(0.5), DVec2::ZERO, 0.1)];

@@ -18,8 +18,8 @@ use crate::segment::Segments;
 pub use drop::DropConfig;
 pub use effects::Effects;
 pub use spawn::{
-    MAX_AREA_FRACTION, MAX_ATTEMPTS_PER_CIRCLE, MIN_RADIUS_FRACTION, MassModel, Placement,
-    SpawnConfig, min_radius,
+    MAX_AREA_FRACTION, MAX_ATTEMPTS_PER_CIRCLE, MAX_PACK_CIRCLES, MIN_RADIUS_FRACTION, MassModel,
+    Placement, SpawnConfig, min_radius,
 };
 
 mod drop;

@@ -19,6 +19,10 @@ pub const MIN_RADIUS_FRACTION: f64 = 1e-9;
 /// Most placement attempts per circle a spawn rule may ask for: beyond a few hundred, misses
 /// mean the arena is full, and more tries only make a full arena slower to give up on.
 pub const MAX_ATTEMPTS_PER_CIRCLE: u32 = 10_000;
+/// Most circles a `pack` placement compresses: about 20 s of compression, and a jam is refused
+/// within a few minutes (a stage may take 2000 events per circle before it counts as jammed).
+/// Past it, `lattice` fills equal circles at once.
+pub const MAX_PACK_CIRCLES: usize = 100_000;
 /// Densest area fraction random placement is asked for (0.907 is the densest packing of equal
 /// disks; placement by rejection stalls long before it).
 pub const MAX_AREA_FRACTION: f64 = 0.9;
@@ -221,6 +225,15 @@ impl SpawnConfig {
         }
         if self.placement == Placement::Lattice {
             self.check_lattice(arena, n, r0)?;
+        }
+        if self.placement == Placement::Pack && n > MAX_PACK_CIRCLES {
+            return Err(FieldError::new(
+                "count",
+                format!(
+                    "asks `pack` to compress {n} circles; it compresses at most \
+                     {MAX_PACK_CIRCLES} (about 20 s); `lattice` places more equal circles at once"
+                ),
+            ));
         }
         if !(1..=MAX_ATTEMPTS_PER_CIRCLE).contains(&self.attempts_per_circle) {
             return Err(FieldError::new(

@@ -155,7 +155,8 @@ fn pack_start(
 }
 
 /// The `loose` circles grown back to their `radii` by a compression, each keeping its speed in
-/// the direction the compression left it moving. A jammed compression is an error naming what was asked for.
+/// the direction the compression left it moving. A jammed compression is an error naming what
+/// was asked for and how far it got.
 fn grow_back(
     arena: &Arena,
     config: &SpawnConfig,
