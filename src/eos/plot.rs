@@ -5,6 +5,7 @@
 //! Liu in per cent, with the ±0.5 % band.
 
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::EosPoint;
@@ -47,25 +48,8 @@ fn z_panel<DB: DrawingBackend>(
         .chain([LARGE_N_AT_070.1, henderson_z(0.72)])
         .filter(|z| z.is_finite())
         .fold(1.0, f64::max);
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!("hard disks, N = {n}, periodic: Z = PA/(NkT) against area fraction"),
-            font(18),
-        )
-        .margin(14)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(0.0..0.75, 0.0..(top * 1.05).ceil())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .light_line_style(WHITE)
-        .label_style(font(13))
-        .axis_desc_style(font(14))
-        .x_desc("area fraction η")
-        .y_desc("Z")
-        .draw()
-        .map_err(err)?;
+    let caption = format!("hard disks, N = {n}, periodic: Z = PA/(NkT) against area fraction");
+    let mut chart = against_eta(area, &caption, 0.0..(top * 1.05).ceil(), "Z")?;
     let curve = |z: fn(f64) -> f64, from: f64, to: f64| {
         (0..=200)
             .map(move |i| from + (to - from) * i as f64 / 200.0)
@@ -148,22 +132,8 @@ fn deviation_panel<DB: DrawingBackend>(
             })
             .filter(|v| v.is_finite())
             .fold(0.8, f64::max);
-    let mut chart = ChartBuilder::on(area)
-        .caption("measured Z against Liu's, per cent", font(18))
-        .margin(14)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(0.0..0.75, -reach..reach)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .light_line_style(WHITE)
-        .label_style(font(13))
-        .axis_desc_style(font(14))
-        .x_desc("area fraction η")
-        .y_desc("Z / Z_Liu − 1 (%)")
-        .draw()
-        .map_err(err)?;
+    let caption = "measured Z against Liu's, per cent";
+    let mut chart = against_eta(area, caption, -reach..reach, "Z / Z_Liu − 1 (%)")?;
     chart
         .draw_series([Rectangle::new(
             [(0.0, -0.5), (FLUID_LIMIT, 0.5)],
@@ -222,4 +192,31 @@ fn deviation_panel<DB: DrawingBackend>(
         font(13),
     ))
     .map_err(err)
+}
+
+/// A panel over area fractions 0 to 0.75 with `caption`, `y` as its vertical range and
+/// `y_desc` as its label, its mesh drawn.
+fn against_eta<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    y: std::ops::Range<f64>,
+    y_desc: &str,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, font(18))
+        .margin(14)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0..0.75, y)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .light_line_style(WHITE)
+        .label_style(font(13))
+        .axis_desc_style(font(14))
+        .x_desc("area fraction η")
+        .y_desc(y_desc)
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }
