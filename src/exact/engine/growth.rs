@@ -24,8 +24,12 @@ impl EventEngine {
             .collect();
         let width = cell_width(arena, &grown);
         let largest = grown.iter().map(|c| c.radius).fold(0.0, f64::max);
+        // Cells a largest grown diameter wide hold every circle: none is kept out as large
+        // (its reach would be worked out for the radius it starts with).
         let mut engine =
             Self::with_cells(circles, arena, &[], (1.0, 1.0), width.max(2.0 * largest));
+        // Predicted once more with the growth: N predictions against the few hundred events
+        // per circle a compression takes.
         engine.growth = growth;
         engine.predict_all();
         engine
