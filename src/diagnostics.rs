@@ -29,7 +29,7 @@ pub struct Pressure {
 impl Pressure {
     /// Pressure of `n` circles with total kinetic energy `kinetic_energy` in `arena`, from the
     /// counters over `elapsed`. `None` where it is undefined (no time, no circles, no motion,
-    /// or no walls).
+    /// or no walls) or too large for an f64 (a gas that all but stopped after huge impulses).
     pub fn measure(
         elapsed: &StepTotals,
         pairs: &PairCollisions,
@@ -47,13 +47,15 @@ impl Pressure {
         let perimeter = 2.0 * (size.x + size.y);
         Self {
             z_virial: Some(z_virial),
-            z_wall: (!arena.is_periodic()).then(|| walls.impulse / (t * perimeter) * area / n_kt),
+            z_wall: (!arena.is_periodic())
+                .then(|| walls.impulse / (t * perimeter) * area / n_kt)
+                .filter(|z| z.is_finite()),
         }
     }
 
     /// `z` from the collisional virial alone (see [`Pressure::z_virial`]), for any window of
     /// the counters: what a periodic box or a window of samples needs. `None` where it is
-    /// undefined (no time, no circles, no motion).
+    /// undefined (no time, no circles, no motion) or too large for an f64.
     pub fn virial_z(
         elapsed: &StepTotals,
         pairs: &PairCollisions,
@@ -62,7 +64,9 @@ impl Pressure {
     ) -> Option<f64> {
         let t = elapsed.sim_seconds;
         let n_kt = kinetic_energy; // N·kT = total kinetic energy in 2D
-        (t > 0.0 && n > 0 && n_kt > 0.0).then(|| 1.0 + pairs.virial / (2.0 * t * n_kt))
+        (t > 0.0 && n > 0 && n_kt > 0.0)
+            .then(|| 1.0 + pairs.virial / (2.0 * t * n_kt))
+            .filter(|z| z.is_finite())
     }
 }
 
@@ -215,5 +219,38 @@ fn take_baseline(
         *elapsed = StepTotals::default();
         *pairs = PairCollisions::default();
         *walls = WallCollisions::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arena::Boundary;
+
+    /// A gas that all but stopped (inelastic hits under a huge gravity) after large impulses:
+    /// `z` overflows an f64 and is reported as undefined, not as infinity.
+    #[test]
+    fn a_pressure_too_large_for_an_f64_is_undefined() {
+        let elapsed = StepTotals {
+            steps: 4,
+            sim_seconds: 0.0667,
+        };
+        let pairs = PairCollisions {
+            count: 90,
+            virial: 1e60,
+            ..default()
+        };
+        let walls = WallCollisions {
+            count: u64::MAX,
+            impulse: 1e58,
+        };
+        let arena = Arena::centered(DVec2::splat(1e-3)).with_boundary(Boundary::Walls);
+        let stopped = Pressure::measure(&elapsed, &pairs, &walls, 16, 1e-300, &arena);
+        assert_eq!(stopped, Pressure::default());
+        assert_eq!(Pressure::virial_z(&elapsed, &pairs, 16, 1e-300), None);
+
+        let moving = Pressure::measure(&elapsed, &pairs, &walls, 16, 1e58, &arena);
+        assert!(moving.z_virial.is_some_and(f64::is_finite));
+        assert!(moving.z_wall.is_some_and(f64::is_finite));
     }
 }

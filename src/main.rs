@@ -137,8 +137,9 @@ struct RunArgs {
     /// Seed of the random placement (overrides the scene).
     #[arg(long)]
     seed: Option<u64>,
-    /// Where a scene's circles are spawned: `random`, or `lattice` (a triangular lattice of
-    /// equal circles, for dense states up to area fraction ~0.88; overrides the scene).
+    /// Where a scene's circles are spawned (overrides the scene): `random`; `lattice` (a
+    /// triangular lattice of equal circles, up to area fraction ~0.88); or `pack` (any radii,
+    /// compressed under the event engine, up to ~0.85).
     #[arg(long)]
     placement: Option<Placement>,
     /// Fill this area fraction with a scene's circles (overrides the scene's count).
