@@ -1,7 +1,8 @@
 //! Whole-App benchmarks: one `app.update()` (exactly one fixed step) of a headless app, after
 //! `finish()`, spawning and one warm-up step. Per solver on gases of growing N, and the price of
 //! effects: a no-collision scene against the same scene with collisions and against bare
-//! integration; collision messages off and on; and a gas without and among 2000 segment walls.
+//! integration; collision messages off and on; a gas without and among 2000 segment walls; and
+//! a sparse step, where the step's own work is all there is.
 //!
 //! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver and
 //! N = 1M for `discrete`.
@@ -151,5 +152,33 @@ fn eos_point(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, solvers, effects, hit_messages, segments, eos_point);
+/// What a sparse step costs under `exact`: 2000 circles of radius 0.001 in a unit box with walls
+/// (area fraction 0.006) at speeds 0.005-0.015, the shape of `p2000.txt`, whose steps of 1/60 s
+/// hold about two collisions each: what is left is the step's own work, per circle.
+fn sparse_step(c: &mut Criterion) {
+    let n = 2000;
+    let config = CirclesConfig {
+        arena: Arena::unit_square(Boundary::Walls),
+        spawn: SpawnConfig {
+            count: n,
+            radius: (0.001, 0.001),
+            speed: (0.005, 0.015),
+            seed: 1,
+            ..SpawnConfig::default()
+        },
+        solver: Solver::Exact,
+        ..CirclesConfig::default()
+    };
+    bench_config(c, "step_sparse", BenchmarkId::new("exact", n), n, config);
+}
+
+criterion_group!(
+    benches,
+    solvers,
+    effects,
+    hit_messages,
+    segments,
+    eos_point,
+    sparse_step
+);
 criterion_main!(benches);

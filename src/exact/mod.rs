@@ -7,14 +7,19 @@
 //!   past the bound the rest of the step is free flight and the missed hits resolve next step.
 //!
 //! Both handle walls, periodic edges and collisions themselves, so they run in the
-//! [`ContinuousStep`] schedule after the force effects, as three systems: gather the circles
-//! into the engine (rebuilding it if needed), advance it by the step, write the circles back.
+//! [`ContinuousStep`] schedule after the force effects, as one system in three parts: gather the
+//! circles into the engine (rebuilding it if needed), advance it by the step, write the circles
+//! back. One system, so that its change filters see only what others wrote since its last
+//! write-back: a step where nothing outside touched the circles pays for its events and one
+//! write per circle, not for comparing every circle.
 
 pub mod engine;
 pub mod pack;
 pub mod queue;
 pub mod toi;
 
+use bevy::ecs::entity::EntityHashMap;
+use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
@@ -22,7 +27,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::CircleState;
 use crate::collide::PairCollisions;
-use crate::components::{Restitution, SolverCircles};
+use crate::components::{Mass, Position, Radius, Restitution, SolverCircles, Velocity};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
@@ -52,20 +57,21 @@ impl Plugin for ContinuousPlugin {
             .add_message::<WallHit>()
             .add_systems(
                 ContinuousStep,
-                (gather_into_engine, advance_engine, write_back)
-                    .chain()
-                    .in_set(CircleSystems::Continuous),
+                continuous_step.in_set(CircleSystems::Continuous),
             );
     }
 }
 
-/// The engine kept between `exact` steps, with what it last wrote to the ECS, so a change made
-/// by anything else can be detected.
+/// The engine kept between `exact` steps, with the entities of its circles (in the order of
+/// [`SolverCircles`] when it was built) and each one's index in it.
 #[derive(Resource, Default)]
 pub struct EngineState {
     engine: Option<EventEngine>,
     entities: Vec<Entity>,
-    written: Vec<(DVec2, DVec2)>,
+    index: EntityHashMap<usize>,
+    /// Whether the last write-back found the circles in another order than `entities` (an
+    /// entity moved between archetypes), so the next step rebuilds.
+    reordered: bool,
     setup: Option<(Arena, Effects, Solver)>,
     /// The segment walls the engine was built with.
     segments: Segments,
@@ -115,38 +121,108 @@ impl EngineState {
         }
         self.last_stats = engine.stats();
         self.engine = Some(engine);
-        self.entities = circles.iter().map(|&(e, _)| e).collect();
-        self.written = states.iter().map(|c| (c.position, c.velocity)).collect();
+        self.know(circles.iter().map(|&(e, _)| e).collect());
         self.setup = Some((arena, effects, Solver::Exact));
         self.segments = segments.clone();
         Ok(())
     }
+
+    /// Takes `entities` as the engine's circles, in index order.
+    fn know(&mut self, entities: Vec<Entity>) {
+        self.index = entities.iter().enumerate().map(|(i, &e)| (e, i)).collect();
+        self.entities = entities;
+        self.reordered = false;
+    }
+}
+
+/// The circles anything but [`continuous_step`] wrote to since that system last ran (or that
+/// were spawned since): the only ones it looks at closely when it keeps its engine.
+type ChangedCircles<'w, 's> = Query<
+    'w,
+    's,
+    Entity,
+    (
+        With<Position>,
+        With<Velocity>,
+        With<Radius>,
+        With<Mass>,
+        Or<(
+            Changed<Position>,
+            Changed<Velocity>,
+            Changed<Radius>,
+            Changed<Mass>,
+            Changed<Restitution>,
+        )>,
+    ),
+>;
+
+/// What the engine is built for and how far a step takes it.
+#[derive(SystemParam)]
+struct StepSetup<'w> {
+    solver: Res<'w, Solver>,
+    arena: Res<'w, Arena>,
+    effects: Res<'w, Effects>,
+    segments: Res<'w, Segments>,
+    dt: Res<'w, StepDt>,
+}
+
+/// The `swept` / `exact` step: gathers the circles into the engine, advances it by the step and
+/// writes the circles back (see the module docs for why this is one system).
+fn continuous_step(
+    setup: StepSetup,
+    mut state: ResMut<EngineState>,
+    own_restitution: Query<(), With<Restitution>>,
+    mut lost_restitution: RemovedComponents<Restitution>,
+    mut circles: ParamSet<(SolverCircles, ChangedCircles)>,
+    counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
+    messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
+) {
+    let StepSetup {
+        solver,
+        arena,
+        effects,
+        segments,
+        dt,
+    } = setup;
+    let restitution_lost = !lost_restitution.is_empty();
+    lost_restitution.clear();
+    let with_own_restitution = !own_restitution.is_empty();
+    gather_into_engine(
+        (*solver, *arena, *effects, &segments),
+        &mut state,
+        (restitution_lost, with_own_restitution),
+        &mut circles,
+    );
+    advance_engine(*solver, dt.0, &mut state, counted, messages);
+    write_back(&mut state, &mut circles.p0());
 }
 
 /// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
 /// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
 /// paddle); otherwise (and always for `swept`) builds a fresh one from the circles. Says which
-/// in a debug log.
+/// in a debug log. `restitution` says whether a circle lost its own restitution since the last
+/// step, and whether any has one.
 fn gather_into_engine(
-    solver: Res<Solver>,
-    arena: Res<Arena>,
-    effects: Res<Effects>,
-    segments: Res<Segments>,
-    mut state: ResMut<EngineState>,
-    own_restitution: Query<(), With<Restitution>>,
-    circles: SolverCircles,
+    setup: (Solver, Arena, Effects, &Segments),
+    state: &mut EngineState,
+    restitution: (bool, bool),
+    circles: &mut ParamSet<(SolverCircles, ChangedCircles)>,
 ) {
-    let state = &mut *state;
-    let setup = (*arena, *effects, *solver);
+    let (solver, arena, effects, segments) = setup;
+    let (restitution_lost, with_own_restitution) = restitution;
+    let key = (arena, effects, solver);
     let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
-    let reason = match (&mut state.engine, *solver) {
+    let reason = match (&mut state.engine, solver) {
+        (Some(_), Solver::Exact) if restitution_lost => "a circle lost its restitution",
+        (Some(_), Solver::Exact) if state.reordered => "circles moved between archetypes",
         (Some(engine), Solver::Exact)
-            if state.setup == Some(setup) && state.segments == *segments =>
+            if state.setup == Some(key) && state.segments == *segments =>
         {
-            let known = (state.entities.as_slice(), state.written.as_slice());
-            match moved_since(engine, known, &circles, restitution_of) {
+            let changed: Vec<Entity> = circles.p1().iter().collect();
+            let all = circles.p0();
+            match moved_since(engine, &state.index, &changed, &all, restitution_of) {
                 Ok(moved) if moved.is_empty() => return,
-                Ok(moved) if moved.len() <= circles.iter().len() / MOVED_FOR_REBUILD => {
+                Ok(moved) if moved.len() <= all.iter().len() / MOVED_FOR_REBUILD => {
                     for &(i, position, velocity) in &moved {
                         engine.set_motion(i, position, velocity);
                     }
@@ -162,10 +238,11 @@ fn gather_into_engine(
         (_, Solver::Exact) => "new solver, arena, segment walls or effects",
         _ => "swept builds every step",
     };
-    if *solver == Solver::Exact {
+    if solver == Solver::Exact {
         debug!("exact engine: rebuilt ({reason})");
     }
-    let bodies: Vec<CircleState> = circles
+    let all = circles.p0();
+    let bodies: Vec<CircleState> = all
         .iter()
         .map(|(_, p, v, r, m, _)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
         .collect();
@@ -176,44 +253,44 @@ fn gather_into_engine(
         effects.restitution,
         effects.wall_restitution,
     );
-    if !own_restitution.is_empty() {
-        engine.set_own_restitutions(circles.iter().map(|c| restitution_of(c.5)).collect());
+    if with_own_restitution {
+        engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());
     }
     engine.record_hits(effects.hit_messages);
     state.last_stats = engine.stats();
     state.engine = Some(engine);
-    state.entities = circles.iter().map(|(e, ..)| e).collect();
-    state.setup = Some(setup);
+    state.know(all.iter().map(|(e, ..)| e).collect());
+    state.setup = Some(key);
     if state.segments != *segments {
         state.segments = segments.clone();
     }
     state.rebuilds += 1;
 }
 
-/// The circles user code moved or steered since the kept `engine` last wrote them (index, new
-/// position and velocity), in one pass over `circles` against the `known` entities and what was
-/// written to them; or why the engine cannot be kept (a circle came, went, or changed its
-/// radius, mass or restitution).
+/// Of the `changed` circles (written since the kept `engine` last wrote them, or spawned), those
+/// user code moved or steered (index, new position and velocity); or why the engine cannot be
+/// kept (a circle came, went, or changed its radius, mass or restitution). `index` gives each
+/// of the engine's entities its index.
 fn moved_since(
     engine: &EventEngine,
-    known: (&[Entity], &[(DVec2, DVec2)]),
+    index: &EntityHashMap<usize>,
+    changed: &[Entity],
     circles: &SolverCircles,
     restitution_of: impl Fn(Option<&Restitution>) -> f64,
 ) -> Result<Vec<(usize, DVec2, DVec2)>, &'static str> {
-    let (entities, written) = known;
-    if circles.iter().len() != entities.len() {
+    if circles.iter().len() != index.len() {
         return Err("circles were spawned or despawned");
     }
     let mut moved = Vec::new();
-    for (i, (c, (&entity, &was))) in circles.iter().zip(entities.iter().zip(written)).enumerate() {
-        if c.0 != entity {
+    for &entity in changed {
+        let (Some(&i), Ok((_, p, v, r, m, e))) = (index.get(&entity), circles.get(entity)) else {
             return Err("circles were spawned or despawned");
-        }
-        if engine.body(i) != (c.3.0, c.4.inverse(), restitution_of(c.5)) {
+        };
+        if engine.body(i) != (r.0, m.inverse(), restitution_of(e)) {
             return Err("a radius, mass or restitution changed");
         }
-        if (c.1.0, c.2.0) != was {
-            moved.push((i, c.1.0, c.2.0));
+        if (p.0, v.0) != (engine.position(i), engine.velocity(i)) {
+            moved.push((i, p.0, v.0));
         }
     }
     Ok(moved)
@@ -222,23 +299,22 @@ fn moved_since(
 /// Processes the step's events (within the solver's budget), counts what they did and, when
 /// recording, writes their hits as messages.
 fn advance_engine(
-    solver: Res<Solver>,
-    dt: Res<StepDt>,
-    mut state: ResMut<EngineState>,
+    solver: Solver,
+    dt: f64,
+    state: &mut EngineState,
     mut counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
 ) {
-    let state = &mut *state;
     let Some(engine) = state.engine.as_mut() else {
         return;
     };
-    let per_circle = match *solver {
+    let per_circle = match solver {
         Solver::Swept => SWEPT_EVENTS_PER_CIRCLE,
         _ => EXACT_EVENTS_PER_CIRCLE,
     };
     let budget = per_circle * (engine.len() as u64 + 1);
     let t_start = engine.now();
-    let t_end = t_start + dt.0;
+    let t_end = t_start + dt;
     if engine.advance_to(t_end, budget).is_err() {
         engine.drift_to(t_end);
         state.budget_exhausted += 1;
@@ -259,15 +335,18 @@ fn advance_engine(
     walls.impulse += stats.wall_impulse - last.wall_impulse;
 }
 
-/// Writes the engine's positions and velocities back to the circles that changed, and
-/// remembers what it wrote.
-fn write_back(mut state: ResMut<EngineState>, mut circles: SolverCircles) {
-    let state = &mut *state;
+/// Writes the engine's positions and velocities back to the circles that changed. Circles found
+/// in another order than the engine's (an entity moved between archetypes) are written by
+/// entity, and the next step rebuilds.
+fn write_back(state: &mut EngineState, circles: &mut SolverCircles) {
     let Some(engine) = state.engine.as_ref() else {
         return;
     };
-    state.written.clear();
-    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
+    for (i, (entity, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
+        if state.entities.get(i) != Some(&entity) {
+            state.reordered = true;
+            break;
+        }
         let (position, velocity) = (engine.position(i), engine.velocity(i));
         if p.0 != position {
             p.0 = position;
@@ -275,6 +354,12 @@ fn write_back(mut state: ResMut<EngineState>, mut circles: SolverCircles) {
         if v.0 != velocity {
             v.0 = velocity;
         }
-        state.written.push((position, velocity));
+    }
+    if state.reordered {
+        for (i, &entity) in state.entities.iter().enumerate() {
+            if let Ok((_, mut p, mut v, ..)) = circles.get_mut(entity) {
+                (p.0, v.0) = (engine.position(i), engine.velocity(i));
+            }
+        }
     }
 }
