@@ -163,8 +163,20 @@ impl Totals {
     }
 }
 
-/// Measures energy and momentum after every fixed step, and takes the baseline after every
-/// (re)spawn.
+/// When [`CircleDiagnostics`] is measured. Measuring reads every circle, so a headless run that
+/// takes its own totals (`run::advance`) turns it to [`Measuring::AfterSpawn`] while it steps:
+/// its timed steps then pay for nothing nobody reads.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Measuring {
+    /// After every fixed step: what the HUD, the panel and your own systems read.
+    #[default]
+    EveryStep,
+    /// Only after a (re)spawn, for the new baseline.
+    AfterSpawn,
+}
+
+/// Measures energy and momentum after every fixed step (unless [`Measuring`] says otherwise),
+/// and takes the baseline after every (re)spawn.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct DiagnosticsPlugin;
 
@@ -172,6 +184,7 @@ impl Plugin for DiagnosticsPlugin {
     fn build(&self, app: &mut App) {
         let measured = || (measure, take_baseline).chain();
         app.init_resource::<CircleDiagnostics>()
+            .init_resource::<Measuring>()
             .init_resource::<PairCollisions>()
             .init_resource::<WallCollisions>()
             .add_systems(Startup, measured().after(CircleSystems::Spawn))
@@ -181,7 +194,12 @@ impl Plugin for DiagnosticsPlugin {
                     .after(CircleSystems::Spawn)
                     .run_if(resource_changed::<SpawnReport>),
             )
-            .add_systems(FixedUpdate, measured().in_set(CircleSystems::Diagnostics));
+            .add_systems(
+                FixedUpdate,
+                measured()
+                    .in_set(CircleSystems::Diagnostics)
+                    .run_if(resource_equals(Measuring::EveryStep)),
+            );
     }
 }
 

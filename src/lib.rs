@@ -55,7 +55,7 @@ pub mod prelude {
     pub use crate::config::{
         CirclesConfig, DropConfig, Effects, MassModel, Placement, Solver, SpawnConfig,
     };
-    pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin};
+    pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin, Measuring};
     pub use crate::effects::Effect;
     pub use crate::exact::ContinuousPlugin;
     pub use crate::forces::{DragPlugin, GravityPlugin};

@@ -18,7 +18,7 @@ use crate::circle::{CircleState, discs, snapshot};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
 use crate::config::{CirclesConfig, Effects, Solver};
-use crate::diagnostics::{Pressure, Totals, relative_change};
+use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
 use crate::exact::EngineState;
 use crate::schedule::StepTotals;
@@ -123,8 +123,11 @@ impl Progress {
 }
 
 /// Steps `app` until its [`StepTotals`] reach `until`, or until `stop` says so after a step,
-/// timing the steps alone into `progress`. After every step whose number is a multiple of
-/// `sample_every` it measures the overlaps of a snapshot into `progress` and hands the snapshot
+/// timing the steps alone into `progress`. While it steps, the app's
+/// [`CircleDiagnostics`](crate::diagnostics::CircleDiagnostics) are not measured
+/// ([`Measuring::AfterSpawn`]; the run takes its own totals), so they are stale until the app's
+/// next step after this. After every step whose number is a multiple of `sample_every` it
+/// measures the overlaps of a snapshot into `progress` and hands the snapshot
 /// to `observe`. Step numbers count from the start of the run, so a run resumed from a
 /// checkpoint samples exactly the steps the whole run would have. Returns whether `stop` ended
 /// it early.
@@ -136,13 +139,17 @@ pub fn advance(
     stop: impl Fn() -> bool,
     mut observe: impl FnMut(Sample),
 ) -> bool {
-    loop {
+    let measuring = app
+        .world_mut()
+        .get_resource_mut::<Measuring>()
+        .map(|mut measuring| std::mem::replace(&mut *measuring, Measuring::AfterSpawn));
+    let stopped = loop {
         let step = app.world().resource::<StepTotals>().steps;
         if step >= until {
-            return false;
+            break false;
         }
         if stop() {
-            return true;
+            break true;
         }
         let start = Instant::now();
         app.update();
@@ -150,7 +157,11 @@ pub fn advance(
         if (step + 1).is_multiple_of(sample_every.max(1)) {
             take_sample(app.world_mut(), progress, &mut observe);
         }
+    };
+    if let Some(measuring) = measuring {
+        app.world_mut().insert_resource(measuring);
     }
+    stopped
 }
 
 /// Samples the final state of a run that [`advance`] did not sample (its last step not a

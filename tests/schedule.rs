@@ -118,3 +118,33 @@ fn a_part_can_be_disabled_like_any_bevy_plugin_group() {
         "{names:#?}"
     );
 }
+
+#[test]
+fn diagnostics_are_measured_every_step_except_while_a_headless_run_steps() {
+    use moving_circles::run::run_steps;
+    let mut app = moving_circles::run::headless_app(CirclesConfig {
+        solver: Solver::Exact,
+        ..default()
+    });
+    let energy = |app: &App| app.world().resource::<CircleDiagnostics>().kinetic_energy;
+    let push = |app: &mut App| {
+        let world = app.world_mut();
+        for mut v in world.query::<&mut Velocity>().iter_mut(world) {
+            v.0 *= 2.0;
+        }
+    };
+    // Every step: doubled speeds show in the next step's kinetic energy.
+    let before = energy(&app);
+    push(&mut app);
+    step(&mut app, 1);
+    assert_relative("every step", energy(&app), 4.0 * before, 1e-9);
+
+    // A headless run leaves them as they were, and hands measuring back when it ends.
+    push(&mut app);
+    let report = run_steps(&mut app, "test", 3, 1, |_| {});
+    assert_relative("the run's own totals", report.energy_final, 16.0 * before, 1e-9);
+    assert_eq!(energy(&app), 4.0 * before, "not measured while the run stepped");
+    assert_eq!(*app.world().resource::<Measuring>(), Measuring::EveryStep);
+    step(&mut app, 1);
+    assert_relative("after the run", energy(&app), 16.0 * before, 1e-9);
+}
