@@ -142,8 +142,17 @@ fn diagnostics_are_measured_every_step_except_while_a_headless_run_steps() {
     // A headless run leaves them as they were, and hands measuring back when it ends.
     push(&mut app);
     let report = run_steps(&mut app, "test", 3, 1, |_| {});
-    assert_relative("the run's own totals", report.energy_final, 16.0 * before, 1e-9);
-    assert_eq!(energy(&app), 4.0 * before, "not measured while the run stepped");
+    assert_relative(
+        "the run's own totals",
+        report.energy_final,
+        16.0 * before,
+        1e-9,
+    );
+    assert_eq!(
+        energy(&app),
+        4.0 * before,
+        "not measured while the run stepped"
+    );
     assert_eq!(*app.world().resource::<Measuring>(), Measuring::EveryStep);
     step(&mut app, 1);
     assert_relative("after the run", energy(&app), 16.0 * before, 1e-9);

@@ -63,7 +63,7 @@ impl Plugin for ContinuousPlugin {
 }
 
 /// The engine kept between `exact` steps, with the entities of its circles (in the order of
-/// [`SolverCircles`] when it was built) and each one's index in it.
+/// [`SolverCircles`] when it was built) and, once a step needs it, each one's index.
 #[derive(Resource, Default)]
 pub struct EngineState {
     engine: Option<EventEngine>,
@@ -129,7 +129,7 @@ impl EngineState {
 
     /// Takes `entities` as the engine's circles, in index order.
     fn know(&mut self, entities: Vec<Entity>) {
-        self.index = entities.iter().enumerate().map(|(i, &e)| (e, i)).collect();
+        self.index.clear();
         self.entities = entities;
         self.reordered = false;
     }
@@ -220,7 +220,14 @@ fn gather_into_engine(
         {
             let changed: Vec<Entity> = circles.p1().iter().collect();
             let all = circles.p0();
-            match moved_since(engine, &state.index, &changed, &all, restitution_of) {
+            // Built the first time a kept engine needs it, so `swept` (which builds an engine
+            // every step) never does.
+            if !changed.is_empty() && state.index.is_empty() {
+                let entities = state.entities.iter().enumerate();
+                state.index = entities.map(|(i, &e)| (e, i)).collect();
+            }
+            let known = (state.entities.len(), &state.index);
+            match moved_since(engine, known, &changed, &all, restitution_of) {
                 Ok(moved) if moved.is_empty() => return,
                 Ok(moved) if moved.len() <= all.iter().len() / MOVED_FOR_REBUILD => {
                     for &(i, position, velocity) in &moved {
@@ -269,16 +276,17 @@ fn gather_into_engine(
 
 /// Of the `changed` circles (written since the kept `engine` last wrote them, or spawned), those
 /// user code moved or steered (index, new position and velocity); or why the engine cannot be
-/// kept (a circle came, went, or changed its radius, mass or restitution). `index` gives each
-/// of the engine's entities its index.
+/// kept (a circle came, went, or changed its radius, mass or restitution). `known` holds how
+/// many circles the engine has and each one's index by entity.
 fn moved_since(
     engine: &EventEngine,
-    index: &EntityHashMap<usize>,
+    known: (usize, &EntityHashMap<usize>),
     changed: &[Entity],
     circles: &SolverCircles,
     restitution_of: impl Fn(Option<&Restitution>) -> f64,
 ) -> Result<Vec<(usize, DVec2, DVec2)>, &'static str> {
-    if circles.iter().len() != index.len() {
+    let (count, index) = known;
+    if circles.iter().len() != count {
         return Err("circles were spawned or despawned");
     }
     let mut moved = Vec::new();
