@@ -10,8 +10,8 @@
 //! [`ContinuousStep`] schedule after the force effects, as one system in three parts: gather the
 //! circles into the engine (rebuilding it if needed), advance it by the step, write the circles
 //! back. One system, so that its change filters see only what others wrote since its last
-//! write-back: a step where nothing outside touched the circles pays for its events and one
-//! write per circle, not for comparing every circle.
+//! write-back: a step where nothing outside touched the circles pays for its events, Bevy's
+//! change-tick check and one write per circle, not for comparing every circle's values.
 
 pub mod engine;
 pub mod pack;
