@@ -1,7 +1,8 @@
 //! Checkpoint, resume and interruption through the real binary: a run paused at a checkpoint
 //! and resumed ends bit for bit where the run without the pause ends, under every solver; a
 //! signal ends a run after a whole step with its report, final state and checkpoint written,
-//! and a second signal ends it at once without touching what was there.
+//! and a second signal ends it at once without touching what was there. And, in the library, a
+//! resumed `exact` app goes on with the engine it restored instead of rebuilding one.
 #![cfg(unix)]
 
 use std::path::{Path, PathBuf};
@@ -255,4 +256,35 @@ fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
     assert_eq!(text(&report), "old");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "a stray file");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_resumed_exact_run_goes_on_with_the_engine_it_kept() {
+    use moving_circles::checkpoint::Checkpoint;
+    use moving_circles::exact::EngineState;
+    use moving_circles::prelude::*;
+    use moving_circles::run::{Progress, headless_app};
+
+    let mut app = headless_app(CirclesConfig {
+        solver: Solver::Exact,
+        ..Default::default()
+    });
+    for _ in 0..10 {
+        app.update();
+    }
+    let progress = Progress::start(app.world_mut());
+    let checkpoint = Checkpoint::take(app.world_mut(), "test", &progress);
+    let (mut resumed, _) = Checkpoint::from_bytes(&checkpoint.to_bytes(), "test")
+        .unwrap()
+        .resume("test")
+        .unwrap();
+    for _ in 0..3 {
+        resumed.update();
+    }
+    let engine = resumed.world().resource::<EngineState>();
+    assert_eq!(
+        (engine.rebuilds, engine.updates),
+        (0, 0),
+        "the restored engine was kept: every circle is seen as changed once, and found equal"
+    );
 }
