@@ -2,7 +2,7 @@
 //! exactly as the original would have (the lazy motions, every pending event and its time, the
 //! cell lists in their order), and the checks that turn a damaged or forged snapshot into an
 //! error instead of a panic. What follows from the circles and the arena (inverse masses, the
-//! grid, the queue's inner nodes) is rebuilt, not stored.
+//! grid, the queue's blocks and lists) is rebuilt, not stored.
 
 use serde::{Deserialize, Serialize};
 
