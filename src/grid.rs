@@ -147,8 +147,9 @@ impl Grid {
     }
 }
 
-/// Which circles are in which cell, as one linked list per cell: a circle joins or leaves a
-/// cell in O(1), and a cell's members are listed newest first.
+/// Which circles are in which cell (of the arena, or of time in the event queue), as one linked
+/// list per cell: a circle joins or leaves a cell in O(1), and a cell's members are listed
+/// newest first.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CellMembers {
     head: Vec<u32>,

@@ -15,7 +15,7 @@
 //! of the pending times whenever the queue is laid out, at the start and every few updates per
 //! circle.
 
-use crate::grid::NONE;
+use crate::grid::{CellMembers, NONE};
 
 /// Where a circle's time is kept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,11 +47,10 @@ pub struct EventQueue {
     heap: Vec<u32>,
     /// Each circle's index in the heap or in the overflow.
     at: Vec<u32>,
-    /// The list heads of the blocks after the current one, by block number modulo their count
-    /// (a power of two), and the links through the circles.
-    head: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
+    /// One list for each of the `slots` blocks after the current one (a power of two), by block
+    /// number modulo `slots`.
+    lists: CellMembers,
+    slots: usize,
     /// Circles in the lists.
     listed: usize,
     /// Circles due `slots` or more blocks after the current one, in no order.
@@ -74,9 +73,8 @@ impl EventQueue {
             current: 0,
             heap: Vec::new(),
             at: vec![NONE; n],
-            head: vec![NONE; slots],
-            next: vec![NONE; n],
-            prev: vec![NONE; n],
+            lists: CellMembers::new(slots, n),
+            slots,
             listed: 0,
             overflow: Vec::new(),
             until_layout: n,
@@ -132,10 +130,6 @@ impl EventQueue {
         ((time - self.origin) * self.inv_width) as u64
     }
 
-    fn slot_count(&self) -> usize {
-        self.head.len()
-    }
-
     /// Puts circle `i`, in nothing, where its time belongs.
     #[inline]
     fn place_circle(&mut self, i: usize) {
@@ -147,8 +141,8 @@ impl EventQueue {
         let block = self.block(time);
         if block <= self.current {
             self.heap_push(i);
-        } else if block - self.current < self.slot_count() as u64 {
-            self.link(i, block as usize & (self.slot_count() - 1));
+        } else if block - self.current < self.slots as u64 {
+            self.link(i, block as usize & (self.slots - 1));
         } else {
             self.place[i] = Place::Overflow;
             self.at[i] = self.overflow.len() as u32;
@@ -178,13 +172,12 @@ impl EventQueue {
                 self.lay_out();
             } else {
                 self.current += 1;
-                if self.current as usize & (self.slot_count() - 1) == 0 {
+                if self.current as usize & (self.slots - 1) == 0 {
                     // A new round of the lists: the overflow's circles due in it join them.
                     self.spread_overflow();
                 }
-                let slot = self.current as usize & (self.slot_count() - 1);
-                while self.head[slot] != NONE {
-                    let i = self.head[slot] as usize;
+                let slot = self.current as usize & (self.slots - 1);
+                while let Some(i) = self.lists.members(slot).next() {
                     self.unlink(i, slot);
                     self.heap_push(i);
                 }
@@ -213,7 +206,7 @@ impl EventQueue {
         self.until_layout = UPDATES_PER_LAYOUT * self.time.len();
         self.empty_blocks = 0;
         self.heap.clear();
-        self.head.fill(NONE);
+        self.lists.clear();
         self.overflow.clear();
         self.listed = 0;
         self.place.fill(Place::Never);
@@ -241,27 +234,13 @@ impl EventQueue {
     }
 
     fn link(&mut self, i: usize, slot: usize) {
-        let first = self.head[slot];
-        self.next[i] = first;
-        self.prev[i] = NONE;
-        if first != NONE {
-            self.prev[first as usize] = i as u32;
-        }
-        self.head[slot] = i as u32;
+        self.lists.insert(i, slot);
         self.place[i] = Place::Slot(slot as u32);
         self.listed += 1;
     }
 
     fn unlink(&mut self, i: usize, slot: usize) {
-        let (p, n) = (self.prev[i], self.next[i]);
-        if p != NONE {
-            self.next[p as usize] = n;
-        } else {
-            self.head[slot] = n;
-        }
-        if n != NONE {
-            self.prev[n as usize] = p;
-        }
+        self.lists.remove(i, slot);
         self.place[i] = Place::Never;
         self.listed -= 1;
     }
