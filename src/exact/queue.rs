@@ -6,7 +6,9 @@
 //! left in O(1); later ones wait in an overflow, spread into the lists once every `slots` blocks.
 //! A change of time is then O(1) or a heap of a few entries, where the tournament tree it replaced
 //! replayed up to log₂ N matches through two dependent loads each (23-26 % of the engine's time on
-//! the 10k gases; the specialist's calendar, 11-17 %).
+//! the 10k gases; the specialist's calendar, 11-17 %). (The std `BinaryHeap` cannot change a
+//! key, and the indexed-queue crates go through a hash map, which costs more than a whole event
+//! here.)
 //!
 //! Block numbers never decrease as time grows (however the subtraction and the product round), so
 //! every circle in the heap is due no later than every circle outside it, and equal times share a
@@ -55,7 +57,8 @@ pub struct EventQueue {
     listed: usize,
     /// Circles due `slots` or more blocks after the current one, in no order.
     overflow: Vec<u32>,
-    /// Updates left before the next layout.
+    /// Updates left before the next layout: the first comes once every circle can have had a
+    /// time set, the next every `UPDATES_PER_LAYOUT` updates a circle.
     until_layout: usize,
     /// Empty blocks stepped over since the last layout.
     empty_blocks: usize,
