@@ -213,7 +213,7 @@ impl EventQueue {
         self.overflow.clear();
         self.listed = 0;
         self.place.fill(Place::Never);
-        let finite: Vec<f64> = self
+        let mut finite: Vec<f64> = self
             .time
             .iter()
             .copied()
@@ -222,10 +222,9 @@ impl EventQueue {
         let Some(earliest) = finite.iter().copied().reduce(f64::min) else {
             return;
         };
-        let mut ahead: Vec<f64> = finite.iter().map(|t| t - earliest).collect();
-        let middle = ahead.len() / 2;
-        let (_, &mut median, _) = ahead.select_nth_unstable_by(middle, f64::total_cmp);
-        let inv_width = ahead.len() as f64 / (2.0 * median);
+        let middle = finite.len() / 2;
+        let (_, &mut median, _) = finite.select_nth_unstable_by(middle, f64::total_cmp);
+        let inv_width = finite.len() as f64 / (2.0 * (median - earliest));
         if inv_width.is_normal() {
             self.inv_width = inv_width;
         }
