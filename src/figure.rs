@@ -1,5 +1,5 @@
 //! What the commands' figures share: a [`Figure`] is drawn once, generically, and written as
-//! SVG text ([`svg`]) or PNG bytes ([`png`]); all text uses an embedded typeface, so a PNG needs
+//! SVG text ([`svg`]) or PNG bytes ([`png()`]); all text uses an embedded typeface, so a PNG needs
 //! no system font library.
 
 use std::sync::Once;

@@ -41,7 +41,7 @@ pub enum CircleSystems {
     Diagnostics,
 }
 
-/// The schedule of one solver substep. Run by [`run_circle_step`] once per substep.
+/// The schedule of one solver substep. Run by `run_circle_step` once per substep.
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CircleStep;
 

@@ -1,5 +1,5 @@
 //! Segment walls under the discrete solvers: [`SegmentsPlugin`] schedules
-//! [`bounce_off_segments`] when the scene has [`Segments`], and [`reflect_off_segment`] is its
+//! `bounce_off_segments` when the scene has [`Segments`], and [`reflect_off_segment`] is its
 //! kernel: the arena walls' rule, turned to the segment's normal at the point nearest the
 //! circle (at an end, the normal points from the end to the centre).
 //!

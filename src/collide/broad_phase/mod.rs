@@ -1,7 +1,7 @@
 //! Broad phase: which circles overlap, in O(N) instead of O(N²). Circles of similar size are
 //! binned into a uniform cell list ([`cells`]) rebuilt every step by counting sort and scanned
 //! once per pair with a half stencil ([`scan`], parallel over bands of rows); radii spanning
-//! more than [`MULTI_LEVEL_RATIO`] get one grid per size level ([`levels`]).
+//! more than [`MULTI_LEVEL_RATIO`] get one grid per size level (`levels`).
 //!
 //! Cells are at least as wide as the largest diameter, so two overlapping circles always sit in
 //! the same or adjacent cells. The input is `(centre, reach)` per circle: the radius, or for

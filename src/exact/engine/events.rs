@@ -79,7 +79,7 @@ pub(super) const NO_PAIR: BestPair = BestPair {
     partner_count: 0,
 };
 
-/// Why [`EventEngine::advance_to`] stopped early.
+/// Why [`EventEngine::advance_to`](super::EventEngine::advance_to) stopped early.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BudgetExhausted {
     /// Events processed before giving up.

@@ -4,18 +4,18 @@
 //! Each circle has exactly one pending event, its soonest, held in an indexed [`EventQueue`].
 //! A pair event remembers its partner's collision counter; if the partner has collided since,
 //! the event is stale, and since nothing can have happened to the owner before it, the owner is
-//! simply predicted again from that moment ([`predict`]).
+//! simply predicted again from that moment (`predict`).
 //!
 //! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)`, its reference point
 //! moved only where its course changes, and every event time is worked out from reference
 //! points, so the run does not depend on the cells. A [`Grid`] of cells sized to the density
-//! ([`walls::cell_width`]) and at least one diameter of every circle in them wide, with
+//! (`walls::cell_width`) and at least one diameter of every circle in them wide, with
 //! memberships kept up to date by cell-crossing events, keeps prediction local; a few circles far
-//! wider than that stay out of the cells ([`large`]). A crossing changes no trajectory, so it
+//! wider than that stay out of the cells (`large`). A crossing changes no trajectory, so it
 //! bumps no counter (events other circles hold with the crosser stay valid). Segment walls are
 //! listed in the cells they pass within a largest radius of ([`SegmentCells`]), so a circle
 //! looks only at its own cell's list, again after each crossing. In a compression the radii
-//! grow as the circles fly ([`growth`]). Everything is f64.
+//! grow as the circles fly (`growth`). Everything is f64.
 
 mod events;
 mod growth;
