@@ -4,10 +4,8 @@
 //! Time is cut into blocks `width` long. Circles due in the current block sit in a binary heap of
 //! a few entries; those due in the next `slots - 1` blocks sit in one list per block, joined and
 //! left in O(1); later ones wait in an overflow, spread into the lists once every `slots` blocks.
-//! A change of time is then O(1) or a heap of a few entries, where the tournament tree it replaced
-//! replayed up to log₂ N matches through two dependent loads each (23-26 % of the engine's time on
-//! the 10k gases; the specialist's calendar, 11-17 %). (The std `BinaryHeap` cannot change a
-//! key, and the indexed-queue crates go through a hash map, which costs more than a whole event
+//! A change of time is then O(1) or a heap of a few entries. (The std `BinaryHeap` cannot change
+//! a key, and the indexed-queue crates go through a hash map, which costs more than a whole event
 //! here.)
 //!
 //! Block numbers never decrease as time grows (however the subtraction and the product round), so
