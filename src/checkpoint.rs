@@ -14,7 +14,9 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
-use crate::config::{CirclesConfig, DropConfig, Effects, MAX_CIRCLES, Solver, SpawnConfig};
+use crate::config::{
+    CirclesConfig, DropConfig, Effects, MAX_CIRCLES, SoftConfig, Solver, SpawnConfig,
+};
 use crate::error::InputError;
 use crate::exact::EngineState;
 use crate::exact::engine::EngineSnapshot;
@@ -23,10 +25,11 @@ use crate::range::{check_mass, check_vector};
 use crate::run::{Progress, headless_app};
 use crate::schedule::StepTotals;
 use crate::segment::Segments;
+use crate::soft::{CacheSnapshot, SoftState};
 use crate::spawn::{Dropped, SpawnReport};
 
 /// The first field of every checkpoint: what it is and the layout's version.
-const FORMAT: &str = "moving_circles checkpoint 3";
+const FORMAT: &str = "moving_circles checkpoint 4";
 /// Most bytes a checkpoint may have: the most circles an input may ask for, each with its
 /// engine state, fit.
 pub const MAX_CHECKPOINT_BYTES: u64 = 2 << 30;
@@ -40,6 +43,7 @@ pub struct Checkpoint {
     arena: Arena,
     solver: Solver,
     effects: Effects,
+    soft: SoftConfig,
     dt: f64,
     segments: Segments,
     drop: Option<DropConfig>,
@@ -52,6 +56,8 @@ pub struct Checkpoint {
     budget_exhausted: u64,
     progress: Progress,
     engine: Option<EngineSnapshot>,
+    /// The `soft` solver's contacts and impulses, for warm starting.
+    contacts: Option<CacheSnapshot>,
 }
 
 impl Checkpoint {
@@ -59,12 +65,21 @@ impl Checkpoint {
     pub fn take(world: &mut World, source: &str, progress: &Progress) -> Self {
         let engine = world.resource::<EngineState>();
         let (engine, budget_exhausted) = (engine.snapshot(), engine.budget_exhausted);
+        let entities: Vec<Entity> = snapshot_with_entities(world)
+            .iter()
+            .map(|&(e, _)| e)
+            .collect();
+        let contacts = match world.resource::<Solver>() {
+            Solver::Soft(_) => world.resource::<SoftState>().snapshot(&entities),
+            _ => None,
+        };
         Self {
             format: FORMAT.to_owned(),
             source: source.to_owned(),
             arena: *world.resource::<Arena>(),
             solver: *world.resource::<Solver>(),
             effects: *world.resource::<Effects>(),
+            soft: *world.resource::<SoftConfig>(),
             dt: world.resource::<Time<Fixed>>().timestep().as_secs_f64(),
             segments: world.resource::<Segments>().clone(),
             drop: world.get_resource::<DropConfig>().copied(),
@@ -77,6 +92,7 @@ impl Checkpoint {
             budget_exhausted,
             progress: *progress,
             engine,
+            contacts,
         }
     }
 
@@ -168,6 +184,20 @@ impl Checkpoint {
         if self.engine.is_some() != (self.solver == Solver::Exact && !self.circles.is_empty()) {
             return Err("the engine state does not match the solver".to_owned());
         }
+        if let Some(contacts) = &self.contacts {
+            if !matches!(self.solver, Solver::Soft(_)) {
+                return Err("it holds soft contacts for another solver".to_owned());
+            }
+            contacts.check(self.circles.len())?;
+            if let Some(k) = contacts
+                .segments()
+                .find(|&k| k as usize >= self.segments.0.len())
+            {
+                return Err(format!(
+                    "a cached contact names segment wall {k}, which is not there"
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -185,6 +215,7 @@ impl Checkpoint {
             circles: self.circles.clone(),
             segments: self.segments.clone(),
             drop: self.drop,
+            soft: self.soft,
         }
     }
 
@@ -208,6 +239,13 @@ impl Checkpoint {
                 origin,
                 "its circles did not come back as they were written",
             ));
+        }
+        if let Some(contacts) = &self.contacts {
+            let entities: Vec<Entity> = circles.iter().map(|&(e, _)| e).collect();
+            world
+                .resource_mut::<SoftState>()
+                .restore(contacts, &entities)
+                .map_err(|message| InputError::whole(origin, message))?;
         }
         let mut state = world.resource_mut::<EngineState>();
         state.budget_exhausted = self.budget_exhausted;

@@ -49,7 +49,7 @@ pub struct CircleHit<Id: Send + Sync + 'static = Entity> {
 }
 
 /// One of the arena's four walls.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum ArenaWall {
     /// `x = min.x`.
     Left,
@@ -94,7 +94,7 @@ impl ArenaWall {
 }
 
 /// What a circle hit in a [`WallHit`]: one of the arena's walls or a segment wall inside it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Wall {
     /// An edge of the arena.
     Arena(ArenaWall),

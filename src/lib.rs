@@ -1,6 +1,6 @@
 //! Moving, colliding circles on [Bevy](https://bevy.org) 0.19, built the ECS way: an engine you
-//! embed as a plugin group ([`CirclesPlugins`]), four solvers from a cheap discrete step to an
-//! exact event-driven one, and the headless runs and studies the `moving_circles` binary is made
+//! embed as a plugin group ([`CirclesPlugins`]), five solvers from a cheap discrete step to an
+//! exact event-driven one and a contact solver for piles, and the headless runs and studies the `moving_circles` binary is made
 //! of ([`run`], [`commands`]).
 //!
 //! # Getting started
@@ -94,6 +94,7 @@
 //! | `substeps=N` | runs `discrete` N times a step with dt/N: errors shrink roughly like 1/N while the cost grows like N. |
 //! | `swept` | processes each step's pair and wall hits in time order at their times of impact ([`exact`]), afresh every step: no tunnelling, no overlap. |
 //! | `exact` | keeps one event-driven engine ([`exact::engine`]) across steps: the reference, exact to rounding, paying per collision rather than per step. |
+//! | `soft` | the contact solver for games and piles ([`soft`]): persistent speculative contacts made soft springs, warm started and solved in 4 substeps (`soft=N`: N) with relaxation and a restitution pass, so stacks and piles rest. |
 //!
 //! # Modules
 //!
@@ -107,6 +108,7 @@
 //! - [`boundary`]: walls, periodic edges and segment walls;
 //! - [`collide`]: circle-circle collisions of the discrete solvers, the broad phase and the contact kernel;
 //! - [`exact`]: the continuous solvers, `swept` and `exact`, on one event engine;
+//! - [`soft`]: the contact solver, `soft`;
 //! - [`effects`]: the registry that keeps exactly the effects a scene calls for in the schedule;
 //! - [`hits`]: collision messages;
 //! - [`diagnostics`]: energy, momentum and pressure after each step;
@@ -178,6 +180,7 @@ pub mod run;
 pub mod scene;
 pub mod schedule;
 pub mod segment;
+pub mod soft;
 pub mod spawn;
 
 use bevy::app::{PluginGroup, PluginGroupBuilder};
@@ -190,6 +193,7 @@ use exact::ContinuousPlugin;
 use forces::{DragPlugin, GravityPlugin};
 use integrate::IntegratePlugin;
 use schedule::StepPlugin;
+use soft::SoftPlugin;
 use spawn::SpawnPlugin;
 
 /// The common imports: the plugin group and its parts, components, configuration, sets and
@@ -202,7 +206,7 @@ pub mod prelude {
     pub use crate::collide::{CollidePlugin, PairCollisions};
     pub use crate::components::{Mass, Position, Radius, Restitution, Tint, Velocity};
     pub use crate::config::{
-        CirclesConfig, DropConfig, Effects, MassModel, Placement, Solver, SpawnConfig,
+        CirclesConfig, DropConfig, Effects, MassModel, Placement, SoftConfig, Solver, SpawnConfig,
     };
     pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin, Measuring};
     pub use crate::effects::Effect;
@@ -213,6 +217,7 @@ pub mod prelude {
     pub use crate::scene::Scene;
     pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
     pub use crate::segment::{Segment, Segments};
+    pub use crate::soft::SoftPlugin;
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
 }
 
@@ -222,7 +227,8 @@ pub use schedule::CircleSystems;
 /// The simulation as a plugin group: [`StepPlugin`] (first: the others build on it),
 /// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
 /// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
-/// [`ContinuousPlugin`] (the `swept` and `exact` solvers) and [`DiagnosticsPlugin`].
+/// [`ContinuousPlugin`] (the `swept` and `exact` solvers), [`SoftPlugin`] (the `soft` contact
+/// solver) and [`DiagnosticsPlugin`].
 ///
 /// An effect plugin schedules its systems only when the configuration calls for the effect,
 /// so an effect a scene does not ask for costs nothing; it stays registered, so a reloaded
@@ -260,6 +266,7 @@ impl PluginGroup for CirclesPlugins {
             circles,
             segments,
             drop,
+            soft,
         } = self.config;
         PluginGroupBuilder::start::<Self>()
             .add(StepPlugin {
@@ -268,6 +275,7 @@ impl PluginGroup for CirclesPlugins {
                 effects,
                 dt,
                 segments,
+                soft,
             })
             .add(SpawnPlugin {
                 config: spawn,
@@ -282,6 +290,7 @@ impl PluginGroup for CirclesPlugins {
             .add(PeriodicPlugin)
             .add(CollidePlugin)
             .add(ContinuousPlugin)
+            .add(SoftPlugin)
             .add(DiagnosticsPlugin)
     }
 }

@@ -1,12 +1,13 @@
 //! When things run: the public [`CircleSystems`] sets, the [`CircleStep`] schedule that one
 //! (sub)step of the discrete solvers runs, the [`ContinuousStep`] schedule of `swept` and
-//! `exact`, the [`StepTotals`] they advance, and [`StepPlugin`], the core plugin every other
-//! plugin builds on.
+//! `exact`, the [`SoftStep`] schedule of the contact solver, the [`StepTotals`] they advance,
+//! and [`StepPlugin`], the core plugin every other plugin builds on.
 //!
 //! Data flow per fixed step (in `FixedUpdate`):
 //! `CircleSystems::Step` runs [`CircleStep`] `substeps` times with `dt / substeps`
 //! (`Forces` → `Integrate` → `Boundary` → `Collide`), or [`ContinuousStep`] once
-//! (`Forces` → `Continuous`), then `CircleSystems::Diagnostics` measures the result.
+//! (`Forces` → `Continuous`), or [`SoftStep`] once (`Forces` → `Soft`, which substeps inside),
+//! then `CircleSystems::Diagnostics` measures the result.
 //! Spawning happens outside the fixed clock (`Startup` and `PreUpdate`, set `CircleSystems::Spawn`)
 //! so a paused simulation can still be reset.
 
@@ -17,7 +18,7 @@ use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
-use crate::config::{Effects, Solver};
+use crate::config::{Effects, SoftConfig, Solver};
 use crate::segment::Segments;
 
 /// The system sets of the simulation, in the order they run.
@@ -37,6 +38,9 @@ pub enum CircleSystems {
     Collide,
     /// Advancing a whole step continuously: `swept` / `exact` (inside [`ContinuousStep`]).
     Continuous,
+    /// Advancing a whole step with the contact solver, `soft` (inside [`SoftStep`]): its own
+    /// substeps, gravity, drag, walls and contacts.
+    Soft,
     /// Measuring energy, momentum and collision rates after the step (`FixedUpdate`).
     Diagnostics,
 }
@@ -49,6 +53,12 @@ pub struct CircleStep;
 /// then [`CircleSystems::Continuous`], which handles motion, walls and collisions together.
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ContinuousStep;
+
+/// The schedule of one step of the contact solver (`soft`): force effects of your own in
+/// [`CircleSystems::Forces`], then [`CircleSystems::Soft`], which integrates gravity and drag
+/// itself in every substep.
+#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SoftStep;
 
 /// The simulated time one run of [`CircleStep`] covers, in seconds (`dt / substeps`).
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
@@ -98,6 +108,8 @@ pub struct StepPlugin {
     pub dt: f64,
     /// The segment walls inside the arena.
     pub segments: Segments,
+    /// How the `soft` solver's contacts behave.
+    pub soft: SoftConfig,
 }
 
 impl Default for StepPlugin {
@@ -108,6 +120,7 @@ impl Default for StepPlugin {
             effects: Effects::default(),
             dt: 1.0 / 60.0,
             segments: Segments::default(),
+            soft: SoftConfig::default(),
         }
     }
 }
@@ -122,6 +135,8 @@ impl Plugin for StepPlugin {
             .insert_resource(self.effects)
             .register_type::<Segments>()
             .insert_resource(self.segments.clone())
+            .register_type::<SoftConfig>()
+            .insert_resource(self.soft)
             .insert_resource(Time::<Fixed>::from_duration(Duration::from_secs_f64(
                 self.dt,
             )))
@@ -130,6 +145,7 @@ impl Plugin for StepPlugin {
             .init_resource::<StepTotals>()
             .init_schedule(CircleStep)
             .init_schedule(ContinuousStep)
+            .init_schedule(SoftStep)
             // The step's systems run in a chain, so a multi-threaded executor would only add
             // thread wake-ups to every substep.
             .edit_schedule(CircleStep, |s| {
@@ -138,9 +154,16 @@ impl Plugin for StepPlugin {
             .edit_schedule(ContinuousStep, |s| {
                 s.set_executor(SingleThreadedExecutor::new());
             })
+            .edit_schedule(SoftStep, |s| {
+                s.set_executor(SingleThreadedExecutor::new());
+            })
             .configure_sets(
                 ContinuousStep,
                 (CircleSystems::Forces, CircleSystems::Continuous).chain(),
+            )
+            .configure_sets(
+                SoftStep,
+                (CircleSystems::Forces, CircleSystems::Soft).chain(),
             )
             .configure_sets(
                 CircleStep,
@@ -172,14 +195,19 @@ pub(crate) fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Vi
 }
 
 /// Advances one fixed step with the current [`Solver`]: runs [`CircleStep`] once per substep
-/// with the substep's `dt`, or [`ContinuousStep`] once.
+/// with the substep's `dt`, or [`ContinuousStep`] or [`SoftStep`] once.
 fn run_circle_step(world: &mut World) {
     let solver = *world.resource::<Solver>();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
-    if solver.is_continuous() {
+    let whole_step = match solver {
+        Solver::Swept | Solver::Exact => Some(ContinuousStep.intern()),
+        Solver::Soft(_) => Some(SoftStep.intern()),
+        Solver::Discrete | Solver::Substeps(_) => None,
+    };
+    if let Some(schedule) = whole_step {
         world.resource_mut::<StepDt>().0 = dt;
         world.resource_mut::<SubstepStart>().0 = 0.0;
-        world.run_schedule(ContinuousStep);
+        world.run_schedule(schedule);
     } else {
         let substeps = solver.substeps();
         let sub_dt = dt / f64::from(substeps);
@@ -195,12 +223,13 @@ fn run_circle_step(world: &mut World) {
 }
 
 /// The schedules the simulation adds systems to, in the order a frame meets them.
-pub const SIMULATION_SCHEDULES: [&str; 5] = [
+pub const SIMULATION_SCHEDULES: [&str; 6] = [
     "Startup",
     "PreUpdate",
     "FixedUpdate",
     "CircleStep",
     "ContinuousStep",
+    "SoftStep",
 ];
 
 /// The simulation's systems, as `(schedule, system)` names in execution order, for every

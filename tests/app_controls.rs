@@ -78,6 +78,7 @@ fn plus_and_minus_double_and_halve_the_count() {
 fn digits_switch_the_solver() {
     let mut app = app();
     for (key, solver) in [
+        (KeyCode::Digit5, Solver::Soft(4)),
         (KeyCode::Digit4, Solver::Exact),
         (KeyCode::Digit3, Solver::Swept),
         (KeyCode::Digit2, Solver::Substeps(8)),

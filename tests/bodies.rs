@@ -15,7 +15,7 @@ use moving_circles::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const SOLVERS: [&str; 4] = ["discrete", "substeps=3", "swept", "exact"];
+const SOLVERS: [&str; 5] = ["discrete", "substeps=3", "soft", "swept", "exact"];
 
 fn empty_scene(solver: &str, arena: &str, effects: &str) -> App {
     scene_app(&format!(

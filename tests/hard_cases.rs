@@ -30,11 +30,12 @@ use moving_circles::scene::particles;
 /// Overlap (in smaller radii) that is rounding, not penetration.
 const ROUNDING: f64 = 1e-9;
 
-const SOLVERS: [Solver; 4] = [
+const SOLVERS: [Solver; 5] = [
     Solver::Exact,
     Solver::Swept,
     Solver::Substeps(4),
     Solver::Discrete,
+    Solver::Soft(4),
 ];
 
 fn load(name: &str) -> CirclesConfig {
@@ -57,6 +58,8 @@ struct Outcome {
     max_overlap: f64,
     longest_overlap_steps: u32,
     energy_drift: f64,
+    /// The same, signed: positive is energy gained.
+    energy_change: f64,
     momentum_drift: Option<f64>,
     pair_collisions: u64,
     wall_collisions: u64,
@@ -104,6 +107,7 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
         max_overlap: report.max_penetration,
         longest_overlap_steps,
         energy_drift: report.energy_drift.abs(),
+        energy_change: report.energy_drift,
         momentum_drift: (report.wall_collisions == 0 && scale > 0.0).then(|| {
             (momentum(report.momentum_final) - momentum(report.momentum_initial)).length() / scale
         }),
@@ -136,6 +140,10 @@ fn suite(name: &str, steps: u64) -> Vec<(Solver, Outcome)> {
             let (overlap_bound, overlap_steps, energy_bound) = match solver {
                 Solver::Exact => (ROUNDING, 0, 1e-9),
                 Solver::Swept => (ROUNDING, 0, 1e-6),
+                // A circle deflected within a step can press into one whose contact was only
+                // foreseen as a pass-by, which the next step pushes out softly (measured: 0.034
+                // in the jammed packing); resting contacts press for good.
+                Solver::Soft(_) => (0.05, u32::MAX, f64::INFINITY),
                 // Overlaps in a chain of touching circles relax by diffusion under the one-pass
                 // separation (measured: up to 32 steps in a row of 10).
                 _ => (1.5, 60, 1e-6),
@@ -147,6 +155,9 @@ fn suite(name: &str, steps: u64) -> Vec<(Solver, Outcome)> {
                 o.longest_overlap_steps
             );
             assert!(o.energy_drift <= energy_bound, "{what}: energy drift {:e} > {energy_bound:e}", o.energy_drift);
+            // What every solver promises at e = 1: energy is never gained. `soft` loses it where
+            // contacts rest or hit below the restitution threshold, and bounds nothing else.
+            assert!(o.energy_change <= 1e-9, "{what}: energy gained {:e}", o.energy_change);
             if let Some(m) = o.momentum_drift {
                 assert!(m <= 1e-9, "{what}: momentum drift {m:e} with no wall hit");
             }

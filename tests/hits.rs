@@ -9,7 +9,7 @@ use bevy::prelude::*;
 use common::*;
 use moving_circles::prelude::*;
 
-const SOLVERS: [&str; 4] = ["discrete", "substeps=3", "swept", "exact"];
+const SOLVERS: [&str; 5] = ["discrete", "substeps=3", "soft", "swept", "exact"];
 
 /// What a game-side reader collected: every message, tagged with the step it arrived in.
 #[derive(Resource, Default)]
@@ -69,10 +69,14 @@ fn every_counted_hit_is_one_message_under_every_solver() {
                 (0.0..=dt * (1.0 + 1e-9)).contains(&h.time),
                 "{solver}: {h:?}"
             );
-            // e = 0.9, equal-density circles: j = (1 + e) v_n / (1/m_a + 1/m_b).
+            // e = 0.9, equal-density circles: j = (1 + e) v_n / (1/m_a + 1/m_b). `soft`
+            // reports the whole step's push, which other contacts of the circles in the same
+            // step share: only an isolated hit matches it.
             let mass = |e: Entity| app.world().get::<Mass>(e).unwrap().0;
             let expected = 1.9 * h.normal_speed / (1.0 / mass(h.a) + 1.0 / mass(h.b));
-            assert_relative(solver, h.impulse, expected, 1e-9);
+            if solver != "soft" {
+                assert_relative(solver, h.impulse, expected, 1e-9);
+            }
         }
         for (_, h) in &heard.walls {
             let Wall::Arena(wall) = h.wall else {
@@ -104,7 +108,8 @@ fn every_counted_hit_is_one_message_under_every_solver() {
                 "{solver}: no hit inside a step"
             );
         } else {
-            let substeps = if solver == "discrete" { 1.0 } else { 3.0 };
+            // The discrete solvers at the end of the substep, `soft` at the end of the step.
+            let substeps = if solver == "substeps=3" { 3.0 } else { 1.0 };
             for (_, h) in &heard.circles {
                 let k = h.time / (dt / substeps);
                 assert!(

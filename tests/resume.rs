@@ -52,9 +52,16 @@ fn a_resumed_run_ends_bit_for_bit_where_the_whole_run_ends_under_every_solver() 
     let dir = temp_dir("identical");
     let p = |name: &str| dir.join(name).to_str().unwrap().to_owned();
     let (whole_txt, whole_json, c1) = (p("whole.txt"), p("whole.json"), p("c1"));
-    // A walled rack of billiards and a periodic gas: the engine's events cross the pause.
-    for scene in ["assets/scenes/billiards.ron", "assets/scenes/gas1k.ron"] {
-        for solver in ["discrete", "substeps=4", "swept", "exact"] {
+    // A walled rack of billiards and a periodic gas: the engine's events cross the pause; and a
+    // heap under gravity, whose resting contacts `soft` warm starts across it.
+    let every = ["discrete", "substeps=4", "soft", "swept", "exact"];
+    let runs = [
+        ("assets/scenes/billiards.ron", &every[..]),
+        ("assets/scenes/gas1k.ron", &every[..]),
+        ("assets/scenes/gravity.ron", &["soft"][..]),
+    ];
+    for (scene, solvers) in runs {
+        for &solver in solvers {
             let base = ["run", "--scene", scene, "--solver", solver];
             let whole = [&base[..], &["--steps", "240", "--dump", &whole_txt]].concat();
             run(&[&whole[..], &["--report", &whole_json]].concat());

@@ -104,6 +104,14 @@ pub fn reflect_off_walls(
     x.saturating_add(y)
 }
 
+/// Mirrors a centre past a wall back inside `arena` as a bounce would, leaving any velocity
+/// alone: what a solver does with a centre that something other than motion (a push-out) put
+/// outside.
+pub(crate) fn put_back_inside(position: &mut DVec2, radius: f64, arena: &Arena) {
+    let mut at_rest = DVec2::ZERO;
+    reflect_off_walls(position, &mut at_rest, radius, arena, 1.0);
+}
+
 /// [`reflect_off_walls`], with the hits on the x walls and on the y walls apart.
 pub fn reflect_off_walls_per_axis(
     position: &mut DVec2,

@@ -10,7 +10,7 @@ use super::broad_phase::{
 };
 use super::contact::{combine_restitution, resolve_contact, work_by_immovable};
 use crate::arena::Arena;
-use crate::boundary::reflect_off_walls;
+use crate::boundary::put_back_inside;
 use crate::circle::CircleState;
 use crate::hits::{CircleHit, HitLog};
 
@@ -179,13 +179,6 @@ pub fn resolve_all_contacts(
         }
     }
     stats
-}
-
-/// Mirrors a centre past a wall back inside `arena` as a bounce would, leaving any velocity
-/// alone.
-fn put_back_inside(position: &mut DVec2, radius: f64, arena: &Arena) {
-    let mut at_rest = DVec2::ZERO;
-    reflect_off_walls(position, &mut at_rest, radius, arena, 1.0);
 }
 
 /// Pushes overlapping circles apart (positions only, split by inverse mass, kept inside the

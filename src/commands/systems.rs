@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use crate::config::Solver;
 use crate::io::say;
 use crate::run::headless_app;
 use crate::scene::Scene;
@@ -10,14 +11,15 @@ use crate::schedule::scheduled_systems;
 /// Prints the systems the scene at `scene` schedules, for the step schedule its solver runs.
 pub fn systems(scene: &Path) -> anyhow::Result<()> {
     let config = Scene::load(scene)?;
-    let idle_step = if config.solver.is_continuous() {
-        "CircleStep"
-    } else {
-        "ContinuousStep"
+    // Each solver runs one of the step schedules; the others' systems never run for it.
+    let step = match config.solver {
+        Solver::Discrete | Solver::Substeps(_) => "CircleStep",
+        Solver::Swept | Solver::Exact => "ContinuousStep",
+        Solver::Soft(_) => "SoftStep",
     };
     let mut app = headless_app(config);
     for (schedule, system) in scheduled_systems(&mut app) {
-        if schedule == idle_step {
+        if schedule.ends_with("Step") && schedule != step {
             continue;
         }
         let name = system.rsplit("::").next().unwrap_or(&system);

@@ -1,5 +1,5 @@
-//! Plain configuration structs for the plugin group: spawning, the solver, the effects a scene
-//! calls for, and [`CirclesConfig`] holding them with the [`Arena`]. Each is a `Resource` once
+//! Plain configuration structs for the plugin group: spawning, the solver and its tuning, the
+//! effects a scene calls for, and [`CirclesConfig`] holding them with the [`Arena`]. Each is a `Resource` once
 //! the plugins are added, so systems and users read (and change) the live settings in one
 //! place. Each has one `check`, used by scene files, the command line and spawning alike, and
 //! the limits they check against are the constants here.
@@ -17,6 +17,7 @@ pub use crate::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, che
 use crate::segment::Segments;
 pub use drop::DropConfig;
 pub use effects::Effects;
+pub use soft::SoftConfig;
 pub use spawn::{
     MAX_AREA_FRACTION, MAX_ATTEMPTS_PER_CIRCLE, MAX_PACK_CIRCLES, MIN_RADIUS_FRACTION, MassModel,
     Placement, SpawnConfig, min_radius,
@@ -24,6 +25,7 @@ pub use spawn::{
 
 mod drop;
 mod effects;
+mod soft;
 mod spawn;
 
 /// Most circles any input may ask for: random spawns and particle files alike. Checked before
@@ -34,11 +36,13 @@ pub const MAX_CIRCLES: usize = 5_000_000;
 /// Smallest and largest fixed step in seconds: below 1 ns the fixed clock (nanoseconds) cannot
 /// represent it; above a minute nothing sensible is being simulated.
 pub const DT_RANGE: (f64, f64) = (1e-9, 60.0);
-/// Most substeps `substeps=N` may ask for.
+/// Most substeps `substeps=N` (and `soft=N`) may ask for.
 pub const MAX_SUBSTEPS: u32 = 1024;
+/// Substeps of `soft` when the name gives none (Box2D v3's default).
+pub const SOFT_SUBSTEPS: u32 = 4;
 
 /// How one fixed step of simulated time is advanced. Written in scenes and on the command line
-/// as `discrete`, `substeps=N`, `swept` or `exact`.
+/// as `discrete`, `substeps=N`, `soft` (or `soft=N`), `swept` or `exact`.
 ///
 /// ```
 /// use moving_circles::config::Solver;
@@ -60,13 +64,17 @@ pub enum Solver {
     Swept,
     /// Event-driven across steps: every hit at its exact time; the reference.
     Exact,
+    /// The contact solver for games and piles: persistent soft contacts, warm started and
+    /// solved `N` times per step with relaxation and a restitution pass ([`SoftConfig`]).
+    Soft(u32),
 }
 
 impl Solver {
-    /// How many times the step schedule runs per fixed step.
+    /// How many substeps one fixed step takes: the step schedule's runs for `substeps=N`, the
+    /// contact solver's substeps for `soft=N`, 1 for the others.
     pub fn substeps(self) -> u32 {
         match self {
-            Self::Substeps(n) => n.max(1),
+            Self::Substeps(n) | Self::Soft(n) => n.max(1),
             _ => 1,
         }
     }
@@ -85,6 +93,8 @@ impl fmt::Display for Solver {
             Self::Substeps(n) => write!(f, "substeps={n}"),
             Self::Swept => write!(f, "swept"),
             Self::Exact => write!(f, "exact"),
+            Self::Soft(SOFT_SUBSTEPS) => write!(f, "soft"),
+            Self::Soft(n) => write!(f, "soft={n}"),
         }
     }
 }
@@ -92,7 +102,7 @@ impl fmt::Display for Solver {
 /// Why a solver name could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
-    "unknown solver `{0}`: expected `discrete`, `substeps=N` (N from 1 to {max}), `swept` or `exact`",
+    "unknown solver `{0}`: expected `discrete`, `substeps=N` (N from 1 to {max}), `soft`, `soft=N`, `swept` or `exact`",
     max = MAX_SUBSTEPS
 )]
 pub struct ParseSolverError(pub String);
@@ -106,10 +116,15 @@ impl FromStr for Solver {
             "discrete" => Ok(Self::Discrete),
             "swept" => Ok(Self::Swept),
             "exact" => Ok(Self::Exact),
+            "soft" => Ok(Self::Soft(SOFT_SUBSTEPS)),
             other => {
-                let n = other.strip_prefix("substeps=").ok_or_else(err)?;
+                let (make, n): (fn(u32) -> Self, _) = match other.split_once('=') {
+                    Some(("substeps", n)) => (Self::Substeps, n),
+                    Some(("soft", n)) => (Self::Soft, n),
+                    _ => return Err(err()),
+                };
                 match n.parse::<u32>() {
-                    Ok(n) if (1..=MAX_SUBSTEPS).contains(&n) => Ok(Self::Substeps(n)),
+                    Ok(n) if (1..=MAX_SUBSTEPS).contains(&n) => Ok(make(n)),
                     _ => Err(err()),
                 }
             }
@@ -150,6 +165,8 @@ pub struct CirclesConfig {
     pub segments: Segments,
     /// Circles dropped in one at a time while it runs, if any.
     pub drop: Option<DropConfig>,
+    /// How the `soft` solver's contacts behave.
+    pub soft: SoftConfig,
 }
 
 impl Default for CirclesConfig {
@@ -164,6 +181,7 @@ impl Default for CirclesConfig {
             circles: Vec::new(),
             segments: Segments::default(),
             drop: None,
+            soft: SoftConfig::default(),
         }
     }
 }
@@ -185,6 +203,7 @@ impl CirclesConfig {
         }
         self.arena.check()?;
         self.effects.check()?;
+        self.soft.check()?;
         self.spawn.mass.check()?;
         self.segments.check(&self.arena)?;
         if let Some(drop) = &self.drop {
@@ -206,6 +225,8 @@ mod tests {
             Solver::Substeps(16),
             Solver::Swept,
             Solver::Exact,
+            Solver::Soft(4),
+            Solver::Soft(12),
         ] {
             assert_eq!(s.to_string().parse::<Solver>(), Ok(s));
         }
@@ -220,6 +241,10 @@ mod tests {
             "substeps=x",
             "substeps=5000",
             "exacts",
+            "soft=0",
+            "soft=",
+            "soft=2000",
+            "substeps",
         ] {
             let err = bad.parse::<Solver>().unwrap_err();
             assert!(err.to_string().contains(&format!("`{bad}`")), "{err}");

@@ -58,7 +58,7 @@ r         reset (same seed)
 space     pause / resume
 .         one step (while paused)
 [ / ]     half / double speed
-1 2 3 4   solver: discrete / substeps=8 / swept / exact
+1 2 3 4 5 solver: discrete / substeps=8 / swept / exact / soft
 mouse     drag a circle to fling it
 h         this help
 p         live panel: plots, sliders, compare

@@ -88,12 +88,13 @@ fn single_step(world: &mut World) {
     }
 }
 
-/// The solvers the app switches between (keys `1` to `4`, and the panel's buttons).
-pub const APP_SOLVERS: [Solver; 4] = [
+/// The solvers the app switches between (keys `1` to `5`, and the panel's buttons).
+pub const APP_SOLVERS: [Solver; 5] = [
     Solver::Discrete,
     Solver::Substeps(8),
     Solver::Swept,
     Solver::Exact,
+    Solver::Soft(4),
 ];
 
 fn switch_solver(keys: Res<ButtonInput<KeyCode>>, mut solver: ResMut<Solver>) {
@@ -102,6 +103,7 @@ fn switch_solver(keys: Res<ButtonInput<KeyCode>>, mut solver: ResMut<Solver>) {
         KeyCode::Digit2,
         KeyCode::Digit3,
         KeyCode::Digit4,
+        KeyCode::Digit5,
     ];
     let chosen = digits
         .into_iter()

@@ -80,6 +80,7 @@ impl Scene {
             circles: Vec::with_capacity(self.circles.len()),
             segments,
             drop: self.drop,
+            soft: self.soft,
         };
         config.check().map_err(field_error)?;
         for (i, spec) in self.circles.iter().enumerate() {

@@ -7,7 +7,7 @@ use bevy::math::DVec2;
 use serde::Deserialize;
 
 use crate::arena::Boundary;
-use crate::config::{DropConfig, Effects, MassModel, Solver, SpawnConfig};
+use crate::config::{DropConfig, Effects, MassModel, SoftConfig, Solver, SpawnConfig};
 use crate::error::InputError;
 
 /// The arena as a scene file gives it.
@@ -72,6 +72,8 @@ pub struct Scene {
     pub mass: MassModel,
     /// How a step is advanced.
     pub solver: Solver,
+    /// How the `soft` solver's contacts behave.
+    pub soft: SoftConfig,
     /// Fixed step in seconds.
     pub dt: f64,
     /// Random circles, if any.
@@ -96,6 +98,7 @@ impl Default for Scene {
             effects: Effects::default(),
             mass: MassModel::default(),
             solver: Solver::default(),
+            soft: SoftConfig::default(),
             dt: 1.0 / 60.0,
             spawn: None,
             circles: Vec::new(),

@@ -12,7 +12,7 @@ use bevy::prelude::*;
 use crate::accuracy::{Case, HORIZON_SECONDS, Row, SOLVERS, compare, trace};
 use crate::arena::Arena;
 use crate::circle::snapshot;
-use crate::config::{CirclesConfig, DropConfig, Effects, Solver, SpawnConfig};
+use crate::config::{CirclesConfig, DropConfig, Effects, SoftConfig, Solver, SpawnConfig};
 use crate::scene::check::first_overlap;
 use crate::segment::Segments;
 use crate::spawn::FixedCircles;
@@ -70,6 +70,7 @@ pub fn current_case(world: &mut World) -> (Case, String) {
         circles: Vec::new(),
         segments: world.resource::<Segments>().clone(),
         drop: world.get_resource::<DropConfig>().copied(),
+        soft: *world.resource::<SoftConfig>(),
     };
     let circles = snapshot(world);
     let from = match first_overlap(&circles, &arena) {

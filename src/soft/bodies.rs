@@ -1,0 +1,110 @@
+//! What the `soft` solver works on: [`Bodies`], the circles of a step as plain arrays, and
+//! [`Softness`], the coefficients that make a contact a damped spring for one substep.
+
+use std::f64::consts::TAU;
+
+use bevy::math::DVec2;
+
+/// The circles of one `soft` step, as plain arrays in one order (the solver's query's).
+#[derive(Clone, Debug, Default)]
+pub struct Bodies {
+    /// Centres.
+    pub position: Vec<DVec2>,
+    /// Velocities.
+    pub velocity: Vec<DVec2>,
+    /// Radii.
+    pub radius: Vec<f64>,
+    /// Inverse masses: 0 for an immovable (static or kinematic) circle.
+    pub inv_mass: Vec<f64>,
+    /// Each circle's own restitution, or empty when every circle takes the scene's.
+    pub restitution: Vec<f64>,
+    /// A stable identity per circle (its entity), so a contact is recognised next step.
+    pub id: Vec<u64>,
+}
+
+impl Bodies {
+    /// Forgets every circle (keeping the buffers).
+    pub fn clear(&mut self) {
+        self.position.clear();
+        self.velocity.clear();
+        self.radius.clear();
+        self.inv_mass.clear();
+        self.restitution.clear();
+        self.id.clear();
+    }
+
+    /// Adds a circle.
+    pub fn push(&mut self, id: u64, position: DVec2, velocity: DVec2, radius: f64, inv_mass: f64) {
+        self.id.push(id);
+        self.position.push(position);
+        self.velocity.push(velocity);
+        self.radius.push(radius);
+        self.inv_mass.push(inv_mass);
+    }
+
+    /// Number of circles.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Circle `i`'s own restitution, or `scene`'s if circles have none.
+    #[inline]
+    pub fn restitution_of(&self, i: usize, scene: f64) -> f64 {
+        self.restitution.get(i).copied().unwrap_or(scene)
+    }
+}
+
+/// A soft constraint for one substep of length `h`: the position error is fed back as a
+/// velocity at `bias_rate`, the impulse is scaled by `mass_scale`, and `impulse_scale` of the
+/// impulse already applied is taken back. Together they make the contact a spring of a given
+/// frequency and damping ratio, integrated implicitly, so it is stable at any stiffness the
+/// substep can resolve (Erin Catto, "Solver2D", 2024).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Softness {
+    /// How fast an overlap is pushed out, per unit of overlap (1/s).
+    pub bias_rate: f64,
+    /// Scale of the rigid impulse.
+    pub mass_scale: f64,
+    /// Share of the accumulated impulse taken back.
+    pub impulse_scale: f64,
+}
+
+impl Softness {
+    /// A rigid constraint: no bias, full impulse.
+    pub const RIGID: Softness = Softness {
+        bias_rate: 0.0,
+        mass_scale: 1.0,
+        impulse_scale: 0.0,
+    };
+
+    /// A spring of `hertz` with damping ratio `zeta`, for substeps of `h` seconds.
+    ///
+    /// ```
+    /// use moving_circles::soft::Softness;
+    ///
+    /// let soft = Softness::new(30.0, 10.0, 1.0 / 240.0);
+    /// // Nearly rigid impulses, an overlap fed back at under ω / (2ζ) per second.
+    /// assert!(soft.mass_scale > 0.5 && soft.mass_scale < 1.0);
+    /// assert!((soft.mass_scale + soft.impulse_scale - 1.0).abs() < 1e-12);
+    /// assert!(soft.bias_rate < std::f64::consts::TAU * 30.0 / 20.0);
+    /// ```
+    pub fn new(hertz: f64, zeta: f64, h: f64) -> Self {
+        if hertz <= 0.0 {
+            return Self::RIGID;
+        }
+        let omega = TAU * hertz;
+        let a1 = 2.0 * zeta + h * omega;
+        let a2 = h * omega * a1;
+        let a3 = 1.0 / (1.0 + a2);
+        Self {
+            bias_rate: omega / a1,
+            mass_scale: a2 * a3,
+            impulse_scale: a3,
+        }
+    }
+}

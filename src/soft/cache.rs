@@ -1,0 +1,220 @@
+//! The [`ContactCache`]: each contact's impulse at the end of a step, kept under its circle's
+//! identity and its partner, so the next step starts from last step's answer (warm starting)
+//! and knows which contacts were already pushing (those do not bounce again); and
+//! [`CacheSnapshot`], the same as plain data for a checkpoint.
+
+use bevy::platform::collections::HashMap;
+use serde::{Deserialize, Serialize};
+
+use super::contacts::{Constraint, Partner};
+use crate::hits::Wall;
+
+/// One contact's impulse, kept for the next step under its circle's identity and its partner.
+#[derive(Clone, Copy, Debug)]
+struct Cached {
+    partner: Partner,
+    impulse: f64,
+    touching: bool,
+}
+
+/// The impulses of last step's contacts, by circle: what warm starting starts from.
+#[derive(Default)]
+pub struct ContactCache {
+    /// Each circle's identity last step, by its index then.
+    ids: Vec<u64>,
+    /// `entries[start[i]..start[i + 1]]` are circle `i`'s contacts (as their `a`).
+    start: Vec<u32>,
+    entries: Vec<Cached>,
+    /// Last step's index of each identity, built only when the circles changed order.
+    index_of: HashMap<u64, u32>,
+}
+
+impl ContactCache {
+    /// Forgets every contact (after a respawn, say).
+    pub fn clear(&mut self) {
+        *self = Self::default();
+    }
+
+    /// Gives every contact in `constraints` the impulse it ended last step with, and whether
+    /// it pushed then. `ids` are the circles' identities now.
+    pub fn warm_start(&mut self, ids: &[u64], constraints: &mut [Constraint]) {
+        if self.entries.is_empty() {
+            return;
+        }
+        let same_order = self.ids == ids;
+        if !same_order && self.index_of.is_empty() {
+            self.index_of = self
+                .ids
+                .iter()
+                .enumerate()
+                .map(|(i, &id)| (id, i as u32))
+                .collect();
+        }
+        for c in constraints.iter_mut() {
+            let a = c.a as usize;
+            let old = if same_order {
+                Some(a)
+            } else {
+                self.index_of.get(&ids[a]).map(|&i| i as usize)
+            };
+            let Some(old) = old else { continue };
+            let (from, to) = (self.start[old] as usize, self.start[old + 1] as usize);
+            if let Some(hit) = self.entries[from..to]
+                .iter()
+                .find(|e| e.partner == c.partner)
+            {
+                c.impulse = hit.impulse;
+                c.was_touching = hit.touching;
+            }
+        }
+    }
+
+    /// The cache as plain data for a checkpoint of circles listed with identities `order`:
+    /// each one's contacts in that order, partners by their index in it. `None` before the
+    /// first step (there is nothing to warm start from).
+    pub fn snapshot(&self, order: &[u64]) -> Option<CacheSnapshot> {
+        if self.start.is_empty() {
+            return None;
+        }
+        let position: HashMap<u64, u32> = order
+            .iter()
+            .enumerate()
+            .map(|(i, &id)| (id, i as u32))
+            .collect();
+        let cached: HashMap<u64, usize> = self
+            .ids
+            .iter()
+            .enumerate()
+            .map(|(i, &id)| (id, i))
+            .collect();
+        let mut snapshot = CacheSnapshot::default();
+        for id in order {
+            let before = snapshot.entries.len();
+            if let Some(&old) = cached.get(id) {
+                let mine = &self.entries[self.start[old] as usize..self.start[old + 1] as usize];
+                snapshot.entries.extend(mine.iter().filter_map(|e| {
+                    let partner = match e.partner {
+                        Partner::Circle(id) => SnapshotPartner::Circle(*position.get(&id)?),
+                        Partner::Wall(wall) => SnapshotPartner::Wall(wall),
+                    };
+                    Some((partner, e.impulse, e.touching))
+                }));
+            }
+            snapshot
+                .counts
+                .push((snapshot.entries.len() - before) as u32);
+        }
+        Some(snapshot)
+    }
+
+    /// The cache of a checkpoint for circles whose identities are now `ids` (in the order the
+    /// checkpoint lists them). Fails, saying why, if it does not fit them.
+    pub fn restore(snapshot: &CacheSnapshot, ids: &[u64]) -> Result<Self, String> {
+        snapshot.check(ids.len())?;
+        let mut start = Vec::with_capacity(ids.len() + 1);
+        start.push(0u32);
+        for &count in &snapshot.counts {
+            start.push(start.last().copied().unwrap_or(0) + count);
+        }
+        let entries = snapshot
+            .entries
+            .iter()
+            .map(|&(partner, impulse, touching)| Cached {
+                partner: match partner {
+                    SnapshotPartner::Circle(k) => Partner::Circle(ids[k as usize]),
+                    SnapshotPartner::Wall(wall) => Partner::Wall(wall),
+                },
+                impulse,
+                touching,
+            })
+            .collect();
+        Ok(Self {
+            ids: ids.to_vec(),
+            start,
+            entries,
+            index_of: HashMap::default(),
+        })
+    }
+
+    /// Keeps the impulses `constraints` ended the step with, for the next step's
+    /// [`ContactCache::warm_start`].
+    pub fn store<'a>(&mut self, ids: &[u64], constraints: impl Iterator<Item = &'a Constraint>) {
+        let mut by_circle: Vec<(u32, Cached)> = constraints
+            .map(|c| {
+                let entry = Cached {
+                    partner: c.partner,
+                    impulse: c.impulse,
+                    touching: c.total_impulse > 0.0,
+                };
+                (c.a, entry)
+            })
+            .collect();
+        by_circle.sort_by_key(|&(a, _)| a);
+        self.ids.clear();
+        self.ids.extend_from_slice(ids);
+        self.index_of.clear();
+        self.start.clear();
+        self.start.resize(ids.len() + 1, 0);
+        for &(a, _) in &by_circle {
+            self.start[a as usize + 1] += 1;
+        }
+        for i in 0..ids.len() {
+            self.start[i + 1] += self.start[i];
+        }
+        self.entries.clear();
+        self.entries.extend(by_circle.into_iter().map(|(_, e)| e));
+    }
+}
+
+/// A contact's other side in a [`CacheSnapshot`]: a circle by its index.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum SnapshotPartner {
+    /// Circle `k` of the checkpoint.
+    Circle(u32),
+    /// An arena or segment wall.
+    Wall(Wall),
+}
+
+/// [`ContactCache`] as plain data for a checkpoint: how many contacts each circle has (as
+/// their first circle), and each contact's partner, impulse and whether it pushed.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CacheSnapshot {
+    counts: Vec<u32>,
+    entries: Vec<(SnapshotPartner, f64, bool)>,
+}
+
+impl CacheSnapshot {
+    /// Whether it can belong to `n` circles: a count per circle adding up to the entries,
+    /// partners among them, impulses finite and not negative.
+    pub fn check(&self, n: usize) -> Result<(), String> {
+        if self.counts.len() != n {
+            return Err(format!(
+                "the contact cache lists {} circles, the checkpoint {n}",
+                self.counts.len()
+            ));
+        }
+        let total: u64 = self.counts.iter().map(|&c| u64::from(c)).sum();
+        if total != self.entries.len() as u64 {
+            return Err("the contact cache's lists do not add up".to_owned());
+        }
+        for &(partner, impulse, _) in &self.entries {
+            if let SnapshotPartner::Circle(k) = partner
+                && k as usize >= n
+            {
+                return Err(format!("a cached contact names circle {k} of {n}"));
+            }
+            if !(impulse.is_finite() && impulse >= 0.0) {
+                return Err(format!("a cached contact impulse is {impulse}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The segment walls the cached contacts name.
+    pub fn segments(&self) -> impl Iterator<Item = u32> + '_ {
+        self.entries.iter().filter_map(|e| match e.0 {
+            SnapshotPartner::Wall(Wall::Segment(k)) => Some(k),
+            _ => None,
+        })
+    }
+}

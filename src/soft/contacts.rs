@@ -1,0 +1,298 @@
+//! The contacts of one `soft` step: which circles may touch a circle, an arena wall or a
+//! segment wall before the step ends ([`find_contacts`]: the broad phase on each circle's reach
+//! over the step, then a speculative margin), each as a [`Constraint`] along a normal fixed for
+//! the step.
+
+use bevy::math::DVec2;
+
+use super::bodies::{Bodies, Softness};
+use crate::arena::Arena;
+use crate::collide::broad_phase::{CellList, overlapping_pairs};
+use crate::collide::contact::{combine_restitution, contact_normal};
+use crate::exact::toi::pair_time_of_impact;
+use crate::grid::NONE;
+use crate::hits::{ArenaWall, Wall};
+use crate::segment::{Segment, SegmentCells};
+
+/// Gap (as a fraction of the smaller radius) within which circles at rest relative to each
+/// other get a contact: Box2D's speculative distance (four linear slops, 2 cm) for bodies of
+/// radius 0.5 m.
+pub const SPECULATIVE_MARGIN: f64 = 0.04;
+
+/// What a contact's second side is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Partner {
+    /// Another circle (by its identity).
+    Circle(u64),
+    /// An arena wall or a segment wall.
+    Wall(Wall),
+}
+
+/// One contact between circle `a` and a circle `b` or a wall, solved along `normal` (from `a`
+/// towards the other side) for the whole step.
+#[derive(Clone, Copy, Debug)]
+pub struct Constraint {
+    /// The first circle.
+    pub a: u32,
+    /// The second circle, or [`NONE`] for a wall.
+    pub b: u32,
+    /// What the other side is, for matching across steps and for messages.
+    pub partner: Partner,
+    /// Unit normal from `a` towards the other side.
+    pub normal: DVec2,
+    /// A pair: what `b`'s position gains to be the image nearest `a` (periodic arenas). A
+    /// wall: the point of the wall the contact presses on.
+    pub anchor: DVec2,
+    /// Distance along the normal at which the two sides touch: `r_a + r_b`, or `r_a` for a wall.
+    pub reach: f64,
+    /// Inverse masses of the two sides (0 for a wall or an immovable circle).
+    pub inv_mass: (f64, f64),
+    /// `1 / (w_a + w_b)`.
+    pub normal_mass: f64,
+    /// How soft the contact is (stiffer against immovable circles and walls).
+    pub soft: Softness,
+    /// Coefficient of restitution of the pair.
+    pub restitution: f64,
+    /// Approach speed below which the contact does not bounce.
+    pub threshold: f64,
+    /// Fastest push-out speed.
+    pub push: f64,
+    /// Normal velocity of `b` relative to `a` when the step began (negative: approaching).
+    pub relative_velocity: f64,
+    /// Impulse accumulated in the current substep (warm started from the last one's).
+    pub impulse: f64,
+    /// Every impulse applied during the step, added up: the momentum it transferred.
+    pub total_impulse: f64,
+    /// Fastest approach along the normal the solver met in the step (what a hit's message
+    /// calls its normal speed).
+    pub approach: f64,
+    /// Whether the contact pushed in the last step (a new push is a collision to count).
+    pub was_touching: bool,
+}
+
+impl Constraint {
+    /// The separation along the normal for `a` at `pa` and the other side at `pb` (a wall's
+    /// anchor, or `b`'s position): negative when they overlap.
+    #[inline]
+    pub fn separation(&self, pa: DVec2, pb: DVec2) -> f64 {
+        (pb - pa).dot(self.normal) - self.reach
+    }
+}
+
+/// The tuning every contact of a step shares.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactRules {
+    /// The fixed step.
+    pub dt: f64,
+    /// Constant acceleration, or zero.
+    pub gravity: DVec2,
+    /// Restitution between circles and against walls, for circles without their own.
+    pub restitution: (f64, f64),
+    /// Softness against movable circles, and against immovable ones and walls.
+    pub soft: (Softness, Softness),
+    /// Push-out speed and restitution threshold, in radii per second.
+    pub push_speed: f64,
+    /// See [`ContactRules::push_speed`].
+    pub threshold: f64,
+    /// Whether circles collide with each other at all.
+    pub collisions: bool,
+}
+
+/// Reusable buffers of contact finding.
+#[derive(Default)]
+pub struct ContactScratch {
+    reach: Vec<(DVec2, f64)>,
+    candidates: Vec<(u32, u32)>,
+    cells: CellList,
+    near: Vec<u32>,
+}
+
+/// Every contact the circles in `bodies` may make during a step under `rules`: pairs (into
+/// `pairs`) and walls (into `walls`), in an order that depends only on the input. A circle's
+/// reach over the step (its radius, plus how far its speed and gravity can take it, plus the
+/// speculative margin) finds the candidates. A candidate pair becomes a contact when it
+/// overlaps (along the normal now), when its straight relative path meets this step (along
+/// the normal where it touches), or when a push from another contact could close its gap
+/// within the step (along the normal where it comes closest); a wall, when its gap can close
+/// within the step.
+pub fn find_contacts(
+    bodies: &Bodies,
+    arena: &Arena,
+    segments: (&[Segment], &SegmentCells),
+    rules: &ContactRules,
+    scratch: &mut ContactScratch,
+    (pairs, walls): (&mut Vec<Constraint>, &mut Vec<Constraint>),
+) {
+    pairs.clear();
+    walls.clear();
+    let dt = rules.dt;
+    let fall = rules.gravity.length() * dt * dt;
+    let travel = |i: usize| bodies.velocity[i].length() * dt + fall;
+    if rules.collisions {
+        scratch.reach.clear();
+        scratch.reach.extend((0..bodies.len()).map(|i| {
+            let r = bodies.radius[i];
+            (
+                bodies.position[i],
+                r * (1.0 + SPECULATIVE_MARGIN) + travel(i),
+            )
+        }));
+        scratch.candidates.clear();
+        let (reach, candidates) = (&scratch.reach, &mut scratch.candidates);
+        overlapping_pairs(&mut scratch.cells, arena, reach, candidates);
+        for &(i, j) in candidates.iter() {
+            if let Some(c) = pair_contact(bodies, arena, rules, (i as usize, j as usize)) {
+                pairs.push(c);
+            }
+        }
+    }
+    if arena.is_periodic() {
+        return;
+    }
+    for i in 0..bodies.len() {
+        if bodies.inv_mass[i] == 0.0 {
+            continue; // immovable circles are kept inside by whoever steers them
+        }
+        let (p, r) = (bodies.position[i], bodies.radius[i]);
+        let limit = r * SPECULATIVE_MARGIN + travel(i);
+        for axis in 0..2 {
+            for high in [false, true] {
+                let wall = ArenaWall::on_axis(axis, high);
+                let (anchor, normal) = wall.contact(p, arena);
+                let gap = (anchor - p).dot(normal) - r;
+                if gap < limit {
+                    walls.push(wall_contact(
+                        bodies,
+                        rules,
+                        i,
+                        Wall::Arena(wall),
+                        anchor,
+                        normal,
+                    ));
+                }
+            }
+        }
+        let (list, cells) = segments;
+        scratch.near.clear();
+        cells.near(p, r + limit, |k| scratch.near.push(k));
+        scratch.near.sort_unstable();
+        scratch.near.dedup();
+        for &k in &scratch.near {
+            let (point, out, distance) = list[k as usize].contact(p, bodies.velocity[i]);
+            if distance - r < limit {
+                walls.push(wall_contact(
+                    bodies,
+                    rules,
+                    i,
+                    Wall::Segment(k),
+                    point,
+                    -out,
+                ));
+            }
+        }
+    }
+}
+
+/// The contact of circles `i` and `j`, if both exist to the solver (one at least movable) and
+/// their gap can close within the step.
+fn pair_contact(
+    bodies: &Bodies,
+    arena: &Arena,
+    rules: &ContactRules,
+    (i, j): (usize, usize),
+) -> Option<Constraint> {
+    let (wa, wb) = (bodies.inv_mass[i], bodies.inv_mass[j]);
+    if wa + wb == 0.0 {
+        return None;
+    }
+    let (pa, pb) = (bodies.position[i], bodies.position[j]);
+    let (va, vb) = (bodies.velocity[i], bodies.velocity[j]);
+    let d = arena.offset(pa, pb);
+    let reach = bodies.radius[i] + bodies.radius[j];
+    let smaller = bodies.radius[i].min(bodies.radius[j]);
+    // Under gravity an immovable partner bends the relative path by up to g·dt²/2.
+    let fall = if wa == 0.0 || wb == 0.0 {
+        rules.gravity.length() * rules.dt * rules.dt
+    } else {
+        0.0
+    };
+    let margin = smaller * SPECULATIVE_MARGIN + fall;
+    let dv = vb - va;
+    let (now, distance) = contact_normal(d, -dv);
+    let normal = if distance < reach {
+        now
+    } else if let Some(t) = pair_time_of_impact(d, dv, reach).filter(|&t| t <= rules.dt) {
+        // They meet this step: along the normal where they touch.
+        contact_normal(d + dv * t, -dv).0
+    } else if distance - reach < margin + (va.length() + vb.length()) * rules.dt {
+        // Not meeting on the straight path, but near enough that a push from another contact
+        // could bring them together within the step (or at rest against each other): along
+        // the normal where they come closest this step, so a pair that passes by (or grazes)
+        // gets no push from its own motion.
+        let closest = (-d.dot(dv) / dv.length_squared()).clamp(0.0, rules.dt);
+        let closest = if closest.is_finite() { closest } else { 0.0 };
+        contact_normal(d + dv * closest, -dv).0
+    } else {
+        return None;
+    };
+    let restitution = combine_restitution(
+        bodies.restitution_of(i, rules.restitution.0),
+        bodies.restitution_of(j, rules.restitution.0),
+    );
+    Some(Constraint {
+        a: i as u32,
+        b: j as u32,
+        partner: Partner::Circle(bodies.id[j]),
+        normal,
+        anchor: pa + d - pb,
+        reach,
+        inv_mass: (wa, wb),
+        normal_mass: 1.0 / (wa + wb),
+        soft: if wa == 0.0 || wb == 0.0 {
+            rules.soft.1
+        } else {
+            rules.soft.0
+        },
+        restitution,
+        threshold: rules.threshold * smaller,
+        push: rules.push_speed * smaller,
+        relative_velocity: (vb - va).dot(normal),
+        impulse: 0.0,
+        total_impulse: 0.0,
+        approach: 0.0,
+        was_touching: false,
+    })
+}
+
+/// The contact of movable circle `i` with a wall at `anchor` whose normal (from the circle) is
+/// `normal`.
+fn wall_contact(
+    bodies: &Bodies,
+    rules: &ContactRules,
+    i: usize,
+    wall: Wall,
+    anchor: DVec2,
+    normal: DVec2,
+) -> Constraint {
+    let (r, w) = (bodies.radius[i], bodies.inv_mass[i]);
+    let own = bodies.restitution_of(i, rules.restitution.1);
+    Constraint {
+        a: i as u32,
+        b: NONE,
+        partner: Partner::Wall(wall),
+        normal,
+        anchor,
+        reach: r,
+        inv_mass: (w, 0.0),
+        normal_mass: 1.0 / w,
+        soft: rules.soft.1,
+        restitution: combine_restitution(own, rules.restitution.1),
+        threshold: rules.threshold * r,
+        push: rules.push_speed * r,
+        relative_velocity: -bodies.velocity[i].dot(normal),
+        impulse: 0.0,
+        total_impulse: 0.0,
+        approach: 0.0,
+        was_touching: false,
+    }
+}

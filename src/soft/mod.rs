@@ -1,0 +1,188 @@
+//! The contact solver for games and piles, `soft` (`soft=N` for `N` substeps, 4 by default):
+//! Box2D v3's soft step for circles. Where `discrete` resolves each overlap once, after the
+//! fact, `soft` keeps every contact that may close during the step ([`contacts`]: speculative,
+//! so a circle at game speed does not tunnel), makes each a damped spring stiff enough to hold
+//! a stack ([`Softness`]), starts each from last step's impulse (warm starting), and solves
+//! them all `N` times per step, relaxing after each substep and bouncing once at the end above
+//! a restitution threshold ([`solve`]). Tuned by [`SoftConfig`].
+//!
+//! [`SoftPlugin`] adds one system to [`SoftStep`]: gather the circles, step the kernel
+//! ([`soft_step`]), write back what changed. It integrates gravity and drag itself in every
+//! substep, and handles the arena's walls, segment walls and collisions, so the effect plugins
+//! add nothing to this schedule: what a scene calls for is what the kernel is told to do.
+
+pub mod bodies;
+pub mod cache;
+pub mod contacts;
+pub mod solve;
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+
+use crate::arena::Arena;
+use crate::boundary::WallCollisions;
+use crate::collide::PairCollisions;
+use crate::components::{Restitution, SolverCircles};
+use crate::config::{Effects, SoftConfig, Solver};
+use crate::hits::{CircleHit, HitLog, WallHit};
+use crate::schedule::{CircleSystems, SoftStep, StepDt};
+use crate::segment::{SegmentCells, Segments};
+pub use bodies::{Bodies, Softness};
+pub use cache::{CacheSnapshot, ContactCache};
+pub use solve::{SoftParams, SoftScratch, SoftStats, soft_step};
+
+/// Adds the `soft` step to [`SoftStep`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SoftPlugin;
+
+impl Plugin for SoftPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<SoftState>()
+            .init_resource::<Segments>()
+            .init_resource::<SoftConfig>()
+            .init_resource::<PairCollisions>()
+            .init_resource::<WallCollisions>()
+            .add_message::<CircleHit>()
+            .add_message::<WallHit>()
+            .add_systems(SoftStep, step_soft.in_set(CircleSystems::Soft));
+    }
+}
+
+/// What the `soft` solver keeps between steps: each contact's impulse (for warm starting), the
+/// segment walls' cells, and its buffers.
+#[derive(Resource, Default)]
+pub struct SoftState {
+    cache: ContactCache,
+    scratch: SoftScratch,
+    bodies: Bodies,
+    entities: Vec<Entity>,
+    segment_cells: Option<(Arena, Segments, SegmentCells)>,
+    log: HitLog,
+    /// What the last step did.
+    pub last: SoftStats,
+}
+
+impl SoftState {
+    /// The contact cache as data for a checkpoint of `circles` (in the checkpoint's order), or
+    /// `None` before the first step.
+    pub fn snapshot(&self, circles: &[Entity]) -> Option<CacheSnapshot> {
+        let order: Vec<u64> = circles.iter().map(|e| e.to_bits()).collect();
+        self.cache.snapshot(&order)
+    }
+
+    /// Puts back the contact cache of a checkpoint for `circles` (in the checkpoint's order),
+    /// so that the next step warm starts as the run would have.
+    pub fn restore(&mut self, snapshot: &CacheSnapshot, circles: &[Entity]) -> Result<(), String> {
+        let ids: Vec<u64> = circles.iter().map(|e| e.to_bits()).collect();
+        self.cache = ContactCache::restore(snapshot, &ids)?;
+        Ok(())
+    }
+}
+
+/// The segment walls' cells for `segments` in `arena` kept in `kept`, listed again only when
+/// either changed.
+fn segment_cells<'a>(
+    kept: &'a mut Option<(Arena, Segments, SegmentCells)>,
+    arena: &Arena,
+    segments: &Segments,
+) -> &'a SegmentCells {
+    let stale = !matches!(kept, Some((a, s, _)) if a == arena && s == segments);
+    if stale {
+        let cells = SegmentCells::over_arena(&segments.0, arena);
+        *kept = Some((*arena, segments.clone(), cells));
+    }
+    &kept.as_ref().expect("set above").2
+}
+
+/// The settings a `soft` step reads.
+#[derive(SystemParam)]
+struct SoftSetup<'w> {
+    solver: Res<'w, Solver>,
+    arena: Res<'w, Arena>,
+    effects: Res<'w, Effects>,
+    segments: Res<'w, Segments>,
+    config: Res<'w, SoftConfig>,
+    dt: Res<'w, StepDt>,
+}
+
+/// Gathers the circles into [`Bodies`], advances them one step with [`soft_step`], writes back
+/// what changed, counts collisions and wall hits and, with `effects.hit_messages`, writes
+/// their messages.
+fn step_soft(
+    setup: SoftSetup,
+    mut state: ResMut<SoftState>,
+    own_restitution: Query<(), With<Restitution>>,
+    counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
+    mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
+    mut circles: SolverCircles,
+) {
+    let SoftSetup {
+        solver,
+        arena,
+        effects,
+        segments,
+        config,
+        dt,
+    } = setup;
+    let SoftState {
+        cache,
+        scratch,
+        bodies,
+        entities,
+        segment_cells: kept_cells,
+        log,
+        last,
+    } = &mut *state;
+    let per_circle = !own_restitution.is_empty();
+    bodies.clear();
+    entities.clear();
+    for (entity, p, v, r, m, own) in &circles {
+        bodies.push(entity.to_bits(), p.0, v.0, r.0, m.inverse());
+        if per_circle {
+            let scene = effects.restitution;
+            bodies.restitution.push(own.map_or(scene, |own| own.0));
+        }
+        entities.push(entity);
+    }
+    let params = SoftParams {
+        dt: dt.0,
+        substeps: solver.substeps(),
+        gravity: effects.gravity.unwrap_or_default(),
+        drag: effects.drag.unwrap_or(0.0),
+        restitution: (effects.restitution, effects.wall_restitution),
+        collisions: effects.collisions,
+        config: *config,
+    };
+    let cells = segment_cells(kept_cells, &arena, &segments);
+    log.clear();
+    let record = effects.hit_messages.then_some(&mut *log);
+    let stats = soft_step(
+        bodies,
+        &arena,
+        (&segments.0, cells),
+        &params,
+        (scratch, cache),
+        record,
+    );
+    *last = stats;
+    let (mut pairs, mut walls) = counted;
+    pairs.count += stats.collisions;
+    pairs.virial += stats.virial;
+    pairs.immovable_work += stats.immovable_work;
+    pairs.immovable_impulse += stats.immovable_impulse;
+    walls.count = walls.count.saturating_add(stats.wall_hits);
+    walls.impulse += stats.wall_impulse;
+    if effects.hit_messages {
+        log.send_circle_hits(|i| entities[i as usize], 0.0, &mut messages.0);
+        log.send_wall_hits(|i| entities[i as usize], 0.0, &mut messages.1);
+    }
+    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
+        let (position, velocity) = (bodies.position[i], bodies.velocity[i]);
+        if p.0 != position {
+            p.0 = position;
+        }
+        if v.0 != velocity {
+            v.0 = velocity;
+        }
+    }
+}
