@@ -14,6 +14,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
+use crate::components::Sleep;
 use crate::config::{
     CirclesConfig, DropConfig, Effects, MAX_CIRCLES, SoftConfig, Solver, SpawnConfig,
 };
@@ -25,6 +26,7 @@ use crate::range::{check_mass, check_vector};
 use crate::run::{Progress, headless_app};
 use crate::schedule::StepTotals;
 use crate::segment::Segments;
+use crate::sleep::Sleeping;
 use crate::soft::{CacheSnapshot, SoftState};
 use crate::spawn::{Dropped, SpawnReport};
 
@@ -50,6 +52,8 @@ pub struct Checkpoint {
     dropped: usize,
     requested: usize,
     circles: Vec<CircleState>,
+    /// Each circle's sleep, in the order of `circles`.
+    sleep: Vec<Sleep>,
     steps: StepTotals,
     pairs: PairCollisions,
     walls: WallCollisions,
@@ -86,6 +90,10 @@ impl Checkpoint {
             dropped: world.resource::<Dropped>().count,
             requested: world.resource::<SpawnReport>().requested,
             circles: snapshot(world),
+            sleep: snapshot_with_entities(world)
+                .iter()
+                .map(|&(e, _)| world.get::<Sleep>(e).copied().unwrap_or_default())
+                .collect(),
             steps: *world.resource::<StepTotals>(),
             pairs: *world.resource::<PairCollisions>(),
             walls: *world.resource::<WallCollisions>(),
@@ -154,6 +162,23 @@ impl Checkpoint {
             return Err(format!(
                 "holds {} circles; at most {MAX_CIRCLES} are supported",
                 self.circles.len()
+            ));
+        }
+        if self.sleep.len() != self.circles.len() {
+            return Err(format!(
+                "holds the sleep of {} circles for {}",
+                self.sleep.len(),
+                self.circles.len()
+            ));
+        }
+        if let Some(i) = self
+            .sleep
+            .iter()
+            .position(|s| !(s.slow_for >= 0.0 && s.slow_for.is_finite()))
+        {
+            return Err(format!(
+                "circle {i} has been at rest for {} s",
+                self.sleep[i].slow_for
             ));
         }
         for (i, c) in self.circles.iter().enumerate() {
@@ -240,6 +265,12 @@ impl Checkpoint {
                 "its circles did not come back as they were written",
             ));
         }
+        for (&(entity, _), &sleep) in circles.iter().zip(&self.sleep) {
+            if let Some(mut kept) = world.get_mut::<Sleep>(entity) {
+                *kept = sleep;
+            }
+        }
+        world.resource_mut::<Sleeping>().count = self.sleep.iter().filter(|s| s.asleep).count();
         if let Some(contacts) = &self.contacts {
             let entities: Vec<Entity> = circles.iter().map(|&(e, _)| e).collect();
             world

@@ -1,5 +1,5 @@
-//! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass` and `Tint`, and
-//! the optional `Restitution`.
+//! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass`, `Tint` and
+//! `Sleep`, and the optional `Restitution`.
 //!
 //! `Position` is deliberately not `Transform`: the simulation owns it, and the render side copies
 //! it into `Transform` only when rendering is on. Inserting a [`Radius`] is what makes an entity a
@@ -22,7 +22,7 @@ pub struct Velocity(pub DVec2);
 /// Radius of a circle. Must be finite and positive; inserting it makes the entity a circle.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Debug)]
-#[require(Position, Velocity, Mass, Tint)]
+#[require(Position, Velocity, Mass, Tint, Sleep)]
 pub struct Radius(pub f64);
 
 /// Mass of a circle.
@@ -99,6 +99,24 @@ impl Default for Tint {
     }
 }
 
+/// Whether a circle sleeps, and how long it has been at rest. A sleeping circle is left where
+/// it is by every solver, at no cost per step, and acts as an immovable circle at rest for the
+/// others until it is woken: by a hit, by your code writing its [`Position`] or [`Velocity`],
+/// or by a change of the effects, the arena, the segment walls or the solver. Only scenes with
+/// gravity sleep ([`SleepConfig`](crate::config::SleepConfig)).
+#[derive(
+    Component, Reflect, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
+)]
+#[reflect(Component, Default, Debug)]
+pub struct Sleep {
+    /// Where the circle was when it last moved: it is at rest while it stays near this point.
+    pub anchor: DVec2,
+    /// Seconds the circle has stayed near its anchor.
+    pub slow_for: f64,
+    /// Whether it sleeps now.
+    pub asleep: bool,
+}
+
 /// The circles as every solver's systems read and write them (the discrete contact pass, the
 /// wall bounce, the continuous step), in one query type so each sees them in the same order.
 pub type SolverCircles<'w, 's> = Query<
@@ -111,6 +129,7 @@ pub type SolverCircles<'w, 's> = Query<
         &'static Radius,
         &'static Mass,
         Option<&'static Restitution>,
+        &'static Sleep,
     ),
 >;
 

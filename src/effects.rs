@@ -31,6 +31,8 @@ pub enum Effect {
     Periodic,
     /// Circle-circle collisions.
     Collisions,
+    /// Circles at rest fall asleep (under gravity).
+    Sleep,
 }
 
 /// The system set holding one effect's systems.
@@ -39,13 +41,14 @@ pub struct EffectSystems(pub Effect);
 
 impl Effect {
     /// Every effect, in schedule order.
-    pub const ALL: [Effect; 6] = [
+    pub const ALL: [Effect; 7] = [
         Effect::Gravity,
         Effect::Drag,
         Effect::Segments,
         Effect::Walls,
         Effect::Periodic,
         Effect::Collisions,
+        Effect::Sleep,
     ];
 
     /// Whether `effects` on an arena with this `boundary` and these `segments` calls for this
@@ -58,6 +61,7 @@ impl Effect {
             Effect::Walls => boundary == Boundary::Walls,
             Effect::Periodic => boundary == Boundary::Periodic,
             Effect::Collisions => effects.collisions,
+            Effect::Sleep => effects.sleep.enabled && effects.gravity.is_some(),
         }
     }
 
@@ -87,6 +91,7 @@ impl Effect {
             Effect::Walls => "walls",
             Effect::Periodic => "periodic",
             Effect::Collisions => "collisions",
+            Effect::Sleep => "sleep",
         }
     }
 }

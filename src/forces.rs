@@ -1,12 +1,12 @@
 //! The force effects: [`GravityPlugin`] (`v += g·dt`) and [`DragPlugin`] (`v *= exp(-drag·dt)`),
 //! in [`CircleSystems::Forces`] before the move, under every solver. Each schedules its system
 //! only when the scene calls for it (`effects.gravity`, `effects.drag`). Immovable circles
-//! (static and kinematic) are left alone.
+//! (static and kinematic) and sleeping ones are left alone.
 
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
-use crate::components::{Mass, Velocity};
+use crate::components::{Mass, Sleep, Velocity};
 use crate::config::Effects;
 use crate::effects::{Effect, EffectSystems, register_effect};
 use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepDt};
@@ -52,12 +52,12 @@ impl Plugin for DragPlugin {
 fn apply_gravity(
     effects: Res<Effects>,
     dt: Res<StepDt>,
-    mut circles: Query<(&mut Velocity, &Mass)>,
+    mut circles: Query<(&mut Velocity, &Mass, &Sleep)>,
 ) {
     let Some(g) = effects.gravity else { return };
     let dv = g * dt.0;
-    circles.par_iter_mut().for_each(|(mut v, m)| {
-        if !m.is_immovable() {
+    circles.par_iter_mut().for_each(|(mut v, m, sleep)| {
+        if !m.is_immovable() && !sleep.asleep {
             v.0 += dv;
         }
     });
@@ -65,11 +65,15 @@ fn apply_gravity(
 
 /// `v *= exp(-drag·dt)`: the exact solution of `v' = -drag·v` over the step, so it can never
 /// overshoot and reverse a velocity however large `dt` is. Immovable circles keep theirs.
-fn apply_drag(effects: Res<Effects>, dt: Res<StepDt>, mut circles: Query<(&mut Velocity, &Mass)>) {
+fn apply_drag(
+    effects: Res<Effects>,
+    dt: Res<StepDt>,
+    mut circles: Query<(&mut Velocity, &Mass, &Sleep)>,
+) {
     let Some(drag) = effects.drag else { return };
     let factor = (-drag * dt.0).exp();
-    circles.par_iter_mut().for_each(|(mut v, m)| {
-        if !m.is_immovable() {
+    circles.par_iter_mut().for_each(|(mut v, m, sleep)| {
+        if !m.is_immovable() && !sleep.asleep {
             v.0 *= factor;
         }
     });

@@ -2,7 +2,7 @@
 
 use bevy::prelude::*;
 
-use crate::components::{Position, Velocity};
+use crate::components::{Position, Sleep, Velocity};
 use crate::schedule::{CircleStep, CircleSystems, StepDt};
 
 /// Moves every circle along its velocity for one (sub)step.
@@ -20,10 +20,14 @@ impl Plugin for IntegratePlugin {
     }
 }
 
-/// `x += v·dt` for every circle. Each circle is independent, so this runs in parallel.
-fn integrate_positions(dt: Res<StepDt>, mut circles: Query<(&mut Position, &Velocity)>) {
+/// `x += v·dt` for every circle awake. Each circle is independent, so this runs in parallel.
+fn integrate_positions(dt: Res<StepDt>, mut circles: Query<(&mut Position, &Velocity, &Sleep)>) {
     let dt = dt.0;
-    circles.par_iter_mut().for_each(|(mut position, velocity)| {
-        position.0 += velocity.0 * dt;
-    });
+    circles
+        .par_iter_mut()
+        .for_each(|(mut position, velocity, sleep)| {
+            if !sleep.asleep {
+                position.0 += velocity.0 * dt;
+            }
+        });
 }

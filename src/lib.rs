@@ -109,6 +109,7 @@
 //! - [`collide`]: circle-circle collisions of the discrete solvers, the broad phase and the contact kernel;
 //! - [`exact`]: the continuous solvers, `swept` and `exact`, on one event engine;
 //! - [`soft`]: the contact solver, `soft`;
+//! - [`sleep`]: circles at rest fall asleep under the time-stepped solvers;
 //! - [`effects`]: the registry that keeps exactly the effects a scene calls for in the schedule;
 //! - [`hits`]: collision messages;
 //! - [`diagnostics`]: energy, momentum and pressure after each step;
@@ -180,6 +181,7 @@ pub mod run;
 pub mod scene;
 pub mod schedule;
 pub mod segment;
+pub mod sleep;
 pub mod soft;
 pub mod spawn;
 
@@ -193,6 +195,7 @@ use exact::ContinuousPlugin;
 use forces::{DragPlugin, GravityPlugin};
 use integrate::IntegratePlugin;
 use schedule::StepPlugin;
+use sleep::SleepPlugin;
 use soft::SoftPlugin;
 use spawn::SpawnPlugin;
 
@@ -204,9 +207,10 @@ pub mod prelude {
     pub use crate::boundary::{PeriodicPlugin, SegmentsPlugin, WallCollisions, WallsPlugin};
     pub use crate::circle::CircleState;
     pub use crate::collide::{CollidePlugin, PairCollisions};
-    pub use crate::components::{Mass, Position, Radius, Restitution, Tint, Velocity};
+    pub use crate::components::{Mass, Position, Radius, Restitution, Sleep, Tint, Velocity};
     pub use crate::config::{
-        CirclesConfig, DropConfig, Effects, MassModel, Placement, SoftConfig, Solver, SpawnConfig,
+        CirclesConfig, DropConfig, Effects, MassModel, Placement, SleepConfig, SoftConfig, Solver,
+        SpawnConfig,
     };
     pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin, Measuring};
     pub use crate::effects::Effect;
@@ -217,6 +221,7 @@ pub mod prelude {
     pub use crate::scene::Scene;
     pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
     pub use crate::segment::{Segment, Segments};
+    pub use crate::sleep::{SleepPlugin, Sleeping};
     pub use crate::soft::SoftPlugin;
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
 }
@@ -228,7 +233,7 @@ pub use schedule::CircleSystems;
 /// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
 /// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
 /// [`ContinuousPlugin`] (the `swept` and `exact` solvers), [`SoftPlugin`] (the `soft` contact
-/// solver) and [`DiagnosticsPlugin`].
+/// solver), [`SleepPlugin`] and [`DiagnosticsPlugin`].
 ///
 /// An effect plugin schedules its systems only when the configuration calls for the effect,
 /// so an effect a scene does not ask for costs nothing; it stays registered, so a reloaded
@@ -291,6 +296,7 @@ impl PluginGroup for CirclesPlugins {
             .add(CollidePlugin)
             .add(ContinuousPlugin)
             .add(SoftPlugin)
+            .add(SleepPlugin)
             .add(DiagnosticsPlugin)
     }
 }

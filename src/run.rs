@@ -17,6 +17,7 @@ use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, discs, snapshot};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
+use crate::components::Sleep;
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
@@ -256,6 +257,8 @@ pub struct Report {
     pub z_wall: Option<f64>,
     /// Steps of `swept` / `exact` whose event budget ran out (rest of the step free flight).
     pub budget_exhausted: u64,
+    /// Circles asleep at the end.
+    pub sleeping: usize,
     /// Whether a signal (SIGINT, SIGTERM) ended the run before its length: the report is of
     /// the steps done.
     pub interrupted: bool,
@@ -294,6 +297,11 @@ impl Report {
         let pairs = *world.resource::<PairCollisions>();
         let walls = *world.resource::<WallCollisions>();
         let arena = *world.resource::<Arena>();
+        let sleeping = world
+            .query::<&Sleep>()
+            .iter(world)
+            .filter(|s| s.asleep)
+            .count();
         let registry = world.resource::<EffectRegistry>();
         let pressure = Pressure::measure(
             &elapsed,
@@ -338,6 +346,7 @@ impl Report {
             z: pressure.z_virial,
             z_wall: pressure.z_wall,
             budget_exhausted: world.resource::<EngineState>().budget_exhausted,
+            sleeping,
             interrupted: false,
         }
     }

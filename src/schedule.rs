@@ -7,7 +7,8 @@
 //! `CircleSystems::Step` runs [`CircleStep`] `substeps` times with `dt / substeps`
 //! (`Forces` → `Integrate` → `Boundary` → `Collide`), or [`ContinuousStep`] once
 //! (`Forces` → `Continuous`), or [`SoftStep`] once (`Forces` → `Soft`, which substeps inside),
-//! then `CircleSystems::Diagnostics` measures the result.
+//! then `CircleSystems::Diagnostics` measures the result. Before the step, `CircleSystems::Sleep`
+//! puts circles at rest to sleep and wakes the ones that were hit or moved.
 //! Spawning happens outside the fixed clock (`Startup` and `PreUpdate`, set `CircleSystems::Spawn`)
 //! so a paused simulation can still be reset.
 
@@ -26,6 +27,9 @@ use crate::segment::Segments;
 pub enum CircleSystems {
     /// Placing circles (`Startup`, and `PreUpdate` for respawn requests).
     Spawn,
+    /// Putting circles at rest to sleep and waking the ones hit or moved from outside, before
+    /// the step (`FixedUpdate`).
+    Sleep,
     /// Advancing one fixed step: runs [`CircleStep`] (`FixedUpdate`).
     Step,
     /// Forces that change velocity: gravity, drag (inside [`CircleStep`]).
@@ -177,7 +181,12 @@ impl Plugin for StepPlugin {
             )
             .configure_sets(
                 FixedUpdate,
-                (CircleSystems::Step, CircleSystems::Diagnostics).chain(),
+                (
+                    CircleSystems::Sleep,
+                    CircleSystems::Step,
+                    CircleSystems::Diagnostics,
+                )
+                    .chain(),
             )
             .add_systems(Startup, allow_long_steps)
             .add_systems(FixedUpdate, run_circle_step.in_set(CircleSystems::Step));

@@ -174,7 +174,7 @@ fn the_hud_shows_what_the_diagnostics_hold() {
         world.resource::<Arena>(),
     );
     for expected in [
-        format!("circles {}", d.count),
+        format!("circles {} (0 asleep)", d.count),
         "solver discrete".to_owned(),
         format!("energy drift {:+.2e}", d.energy_drift()),
         format!("pressure z {:.3}", pressure.z_virial.unwrap()),

@@ -189,7 +189,10 @@ fn bounce_off_walls(
     let (log, entities) = &mut *log;
     let mut hits = 0u64;
     let mut impulse = 0.0f64;
-    for (entity, mut position, mut velocity, radius, mass, own) in &mut circles {
+    for (entity, mut position, mut velocity, radius, mass, own, sleep) in &mut circles {
+        if sleep.asleep {
+            continue;
+        }
         let (mut p, mut v) = (position.0, velocity.0);
         let e = own.map_or(effects.wall_restitution, |own| {
             combine_restitution(own.0, effects.wall_restitution)

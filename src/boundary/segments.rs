@@ -114,7 +114,10 @@ fn bounce_off_segments(
     let Some(cells) = cells.as_ref() else { return };
     let (log, entities, near) = &mut *scratch;
     let (mut hits, mut impulse) = (0u64, 0.0f64);
-    for (entity, mut position, mut velocity, radius, mass, own) in &mut circles {
+    for (entity, mut position, mut velocity, radius, mass, own, sleep) in &mut circles {
+        if sleep.asleep {
+            continue;
+        }
         near.clear();
         cells.near(position.0, radius.0, |k| near.push(k));
         if near.is_empty() {

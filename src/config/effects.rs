@@ -1,5 +1,6 @@
 //! [`Effects`]: which effects a scene calls for and their parameters (restitution, gravity,
-//! drag, collision messages), with the one `check` scenes and the command line use.
+//! drag, collision messages, sleeping), with the one `check` scenes and the command line use;
+//! and [`SleepConfig`], when circles at rest fall asleep.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -28,6 +29,38 @@ pub struct Effects {
     /// [`WallHit`](crate::hits::WallHit) per wall hit, under every solver. Off, nothing is
     /// recorded.
     pub hit_messages: bool,
+    /// When circles at rest fall asleep (only under gravity: without it nothing rests).
+    pub sleep: SleepConfig,
+}
+
+/// When circles at rest fall asleep. A circle is at rest while it stays within `speed · time`
+/// radii of where it last moved, that is, while it moves slower than `speed` on average; a
+/// group of touching circles sleeps once every one of them has been at rest for `time` seconds.
+/// A sleeping circle costs nothing per step and wakes when hit, when your code writes its
+/// `Position` or `Velocity`, or when the effects change. Only scenes with gravity sleep: without
+/// it nothing rests.
+#[derive(Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SleepConfig {
+    /// Whether circles may sleep at all.
+    pub enabled: bool,
+    /// Mean speed below which a circle counts as at rest, in radii per second. Measured by
+    /// displacement rather than velocity, so the resting contacts of the discrete solvers,
+    /// whose velocities shake by what gravity gives in a substep, rest too.
+    pub speed: f64,
+    /// How long a group must stay at rest before it sleeps, in seconds.
+    pub time: f64,
+}
+
+impl Default for SleepConfig {
+    /// Box2D's defaults: 0.05 m/s for a body of radius 0.5 m, for 0.5 s.
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            speed: 0.1,
+            time: 0.5,
+        }
+    }
 }
 
 impl Default for Effects {
@@ -39,6 +72,7 @@ impl Default for Effects {
             restitution: 1.0,
             wall_restitution: 1.0,
             hit_messages: false,
+            sleep: SleepConfig::default(),
         }
     }
 }
@@ -70,6 +104,16 @@ impl Effects {
                 "effects.drag",
                 format!("must be a rate from 0 to {MAX_MAGNITUDE:e} (1/s), got {drag}"),
             ));
+        }
+        let sleep = [
+            ("effects.sleep.speed", self.sleep.speed),
+            ("effects.sleep.time", self.sleep.time),
+        ];
+        for (field, value) in sleep {
+            if !(0.0..=MAX_MAGNITUDE).contains(&value) {
+                let why = format!("must be from 0 to {MAX_MAGNITUDE:e}, got {value}");
+                return Err(FieldError::new(field, why));
+            }
         }
         Ok(())
     }

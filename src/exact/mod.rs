@@ -251,7 +251,7 @@ fn gather_into_engine(
     let all = circles.p0();
     let bodies: Vec<CircleState> = all
         .iter()
-        .map(|(_, p, v, r, m, _)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
+        .map(|(_, p, v, r, m, ..)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
         .collect();
     let mut engine = EventEngine::new(
         &bodies,
@@ -291,7 +291,8 @@ fn moved_since(
     }
     let mut moved = Vec::new();
     for &entity in changed {
-        let (Some(&i), Ok((_, p, v, r, m, e))) = (index.get(&entity), circles.get(entity)) else {
+        let (Some(&i), Ok((_, p, v, r, m, e, _))) = (index.get(&entity), circles.get(entity))
+        else {
             return Err("circles were spawned or despawned");
         };
         if engine.body(i) != (r.0, m.inverse(), restitution_of(e)) {

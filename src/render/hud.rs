@@ -16,6 +16,7 @@ use crate::components::{Position, Radius};
 use crate::config::Solver;
 use crate::diagnostics::{CircleDiagnostics, Pressure};
 use crate::schedule::StepTotals;
+use crate::sleep::Sleeping;
 
 /// The HUD text and the help overlay.
 #[derive(Clone, Copy, Debug, Default)]
@@ -121,6 +122,7 @@ pub struct Measured<'w> {
     pairs: Res<'w, PairCollisions>,
     walls: Res<'w, WallCollisions>,
     arena: Res<'w, Arena>,
+    sleeping: Res<'w, Sleeping>,
 }
 
 fn measure_rates(real: Res<Time<Real>>, measured: Measured, mut rates: ResMut<HudRates>) {
@@ -169,14 +171,16 @@ fn update_hud(
     } else {
         String::new()
     };
-    text.0 = hud_text(d, *solver, &rates, &pressure, &overlaps, &state);
+    let asleep = measured.sleeping.count;
+    text.0 = hud_text(d, asleep, *solver, &rates, &pressure, &overlaps, &state);
 }
 
-/// The HUD's two lines: counts, cost and conservation; then pressure both ways, momentum,
-/// overlaps, escapes and non-finite values. `state` is appended to the first line (pause,
-/// speed).
+/// The HUD's two lines: counts (with how many of the circles sleep), cost and conservation;
+/// then pressure both ways, momentum, overlaps, escapes and non-finite values. `state` is
+/// appended to the first line (pause, speed).
 pub fn hud_text(
     d: &CircleDiagnostics,
+    asleep: usize,
     solver: Solver,
     rates: &HudRates,
     pressure: &Pressure,
@@ -185,7 +189,7 @@ pub fn hud_text(
 ) -> String {
     let z = |z: Option<f64>| z.map_or("-".to_owned(), |z| format!("{z:.3}"));
     format!(
-        "circles {}   solver {solver}   {:.0} steps/s   energy drift {:+.2e}   {:.0} collisions/s{state}   (h: help)\n\
+        "circles {} ({asleep} asleep)   solver {solver}   {:.0} steps/s   energy drift {:+.2e}   {:.0} collisions/s{state}   (h: help)\n\
          pressure z {} (walls {})   momentum ({:+.3e}, {:+.3e})   overlap max {:.3} mean {:.3} r   escaped {}   non-finite {}",
         d.count,
         rates.steps_per_second,

@@ -17,6 +17,7 @@ pub mod contacts;
 pub mod solve;
 
 use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
@@ -136,13 +137,21 @@ fn step_soft(
     let per_circle = !own_restitution.is_empty();
     bodies.clear();
     entities.clear();
-    for (entity, p, v, r, m, own) in &circles {
-        bodies.push(entity.to_bits(), p.0, v.0, r.0, m.inverse());
+    for (entity, p, v, r, m, own, sleep) in &circles {
+        // A sleeping circle is an immovable circle at rest until it is woken.
+        let inverse = if sleep.asleep { 0.0 } else { m.inverse() };
+        bodies.push(entity.to_bits(), p.0, v.0, r.0, inverse);
         if per_circle {
             let scene = effects.restitution;
             bodies.restitution.push(own.map_or(scene, |own| own.0));
         }
         entities.push(entity);
+    }
+    // Everything asleep or static: nothing can move this step.
+    let moving = |i: usize| bodies.inv_mass[i] > 0.0 || bodies.velocity[i] != DVec2::ZERO;
+    if !(0..bodies.len()).any(moving) {
+        *last = SoftStats::default();
+        return;
     }
     let params = SoftParams {
         dt: dt.0,

@@ -1,0 +1,179 @@
+//! Sleeping under the time-stepped solvers: a heap at rest falls asleep and stays exactly where
+//! it is, a ball dropped onto it wakes it and it sleeps again, your code's writes wake a
+//! sleeping circle, a change of the effects wakes them all, and nothing sleeps without gravity.
+
+mod common;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use common::*;
+use moving_circles::circle::{CircleState, snapshot};
+use moving_circles::prelude::*;
+
+/// The time-stepped solvers that hold a heap at rest. `discrete`'s single contact pass does
+/// not: its heap keeps boiling (circles wander a third of a radius in half a second), so it
+/// never sleeps as a whole; a lone circle at rest sleeps under it all the same.
+const TIME_STEPPED: [&str; 2] = ["soft", "substeps=4"];
+
+/// Twenty balls of radius 0.25 dropped at rest into a narrow box under gravity.
+fn heap(solver: &str) -> App {
+    let scene = format!(
+        "(solver: \"{solver}\", arena: (size: (3.0, 8.0)),
+          effects: (gravity: (0.0, -9.81), restitution: 0.3, wall_restitution: 0.3),
+          mass: Equal(1.0),
+          spawn: (count: 20, radius: (0.25, 0.25), speed: (0.0, 0.0), seed: 4))"
+    );
+    let config = Scene::parse(&scene, "heap.ron")
+        .and_then(|s| s.to_config("heap.ron"))
+        .unwrap();
+    create_app(config)
+}
+
+fn asleep(app: &mut App) -> Vec<bool> {
+    app.world_mut()
+        .query::<&Sleep>()
+        .iter(app.world())
+        .map(|s| s.asleep)
+        .collect()
+}
+
+fn positions(circles: &[CircleState]) -> Vec<DVec2> {
+    circles.iter().map(|c| c.position).collect()
+}
+
+/// Steps until every circle sleeps (at most `seconds`), and returns the seconds it took.
+fn until_asleep(app: &mut App, seconds: f64) -> Option<f64> {
+    for k in 1..=(seconds * 60.0) as u64 {
+        step(app, 1);
+        if asleep(app).iter().all(|&s| s) {
+            return Some(k as f64 / 60.0);
+        }
+    }
+    None
+}
+
+#[test]
+fn a_heap_falls_asleep_and_stays_exactly_where_it_is_under_every_time_stepped_solver() {
+    for solver in TIME_STEPPED {
+        let mut app = heap(solver);
+        let took = until_asleep(&mut app, 20.0);
+        eprintln!("{solver}: asleep after {took:?} s");
+        assert!(took.is_some(), "{solver}: the heap never fell asleep");
+        assert_eq!(app.world().resource::<Sleeping>().count, 20, "{solver}");
+        let before = snapshot(app.world_mut());
+        assert!(before.iter().all(|c| c.velocity == DVec2::ZERO), "{solver}");
+        step(&mut app, 600);
+        let after = snapshot(app.world_mut());
+        assert_eq!(
+            positions(&before),
+            positions(&after),
+            "{solver}: a sleeper moved"
+        );
+        assert!(
+            asleep(&mut app).iter().all(|&s| s),
+            "{solver}: woke by itself"
+        );
+    }
+}
+
+#[test]
+fn a_ball_at_rest_on_the_floor_sleeps_under_discrete_too() {
+    let config = Scene::parse(
+        "(solver: \"discrete\", arena: (size: (3.0, 8.0)),
+          effects: (gravity: (0.0, -9.81), restitution: 0.3, wall_restitution: 0.3),
+          circles: [(position: (0.3, 0.0), radius: 0.25)])",
+        "ball.ron",
+    )
+    .and_then(|s| s.to_config("ball.ron"))
+    .unwrap();
+    let mut app = create_app(config);
+    let took = until_asleep(&mut app, 10.0).expect("the ball never slept");
+    let p = snapshot(app.world_mut())[0].position;
+    assert!(
+        took < 5.0 && (p.y + 3.75).abs() < 0.1,
+        "after {took} s at {p}"
+    );
+    step(&mut app, 300);
+    assert_eq!(snapshot(app.world_mut())[0].position, p, "a sleeper moved");
+}
+
+#[test]
+fn a_ball_dropped_on_a_sleeping_heap_wakes_it_and_it_sleeps_again() {
+    for solver in TIME_STEPPED {
+        let mut app = heap(solver);
+        until_asleep(&mut app, 20.0).expect("asleep");
+        let ball = app
+            .world_mut()
+            .spawn((Radius(0.25), Position(DVec2::new(0.1, 3.5)), Mass(1.0)))
+            .id();
+        let mut woke = false;
+        for _ in 0..120 {
+            step(&mut app, 1);
+            woke |= asleep(&mut app).iter().filter(|&&s| !s).count() > 1;
+        }
+        assert!(woke, "{solver}: the hit woke nothing");
+        assert!(
+            until_asleep(&mut app, 20.0).is_some(),
+            "{solver}: never slept again"
+        );
+        let p = app.world().get::<Position>(ball).unwrap().0;
+        assert!(p.y < 3.0, "{solver}: the ball did not land: {p}");
+    }
+}
+
+#[test]
+fn writing_a_sleeping_circles_velocity_wakes_it_and_it_moves() {
+    for solver in TIME_STEPPED {
+        let mut app = heap(solver);
+        until_asleep(&mut app, 20.0).expect("asleep");
+        let (entity, before) = app
+            .world_mut()
+            .query::<(Entity, &Position)>()
+            .iter(app.world())
+            .map(|(e, p)| (e, p.0))
+            .max_by(|a, b| a.1.y.total_cmp(&b.1.y))
+            .unwrap();
+        app.world_mut().get_mut::<Velocity>(entity).unwrap().0 = DVec2::new(0.0, 3.0);
+        step(&mut app, 1);
+        let sleep = *app.world().get::<Sleep>(entity).unwrap();
+        let after = app.world().get::<Position>(entity).unwrap().0;
+        assert!(!sleep.asleep, "{solver}: still asleep");
+        assert!(after.y > before.y, "{solver}: {before} -> {after}");
+    }
+}
+
+#[test]
+fn a_change_of_the_effects_wakes_every_circle() {
+    let mut app = heap("soft");
+    until_asleep(&mut app, 20.0).expect("asleep");
+    app.world_mut().resource_mut::<Effects>().gravity = Some(DVec2::new(-9.81, 0.0));
+    step(&mut app, 1);
+    assert!(
+        asleep(&mut app).iter().all(|&s| !s),
+        "gravity turned sideways, yet circles sleep"
+    );
+    assert_eq!(app.world().resource::<Sleeping>().count, 0);
+}
+
+#[test]
+fn nothing_sleeps_without_gravity_and_sleeping_can_be_switched_off() {
+    // A gas slowed to a crawl by drag rests nowhere: no sleep system is even scheduled.
+    let config = Scene::parse(
+        "(effects: (drag: 5.0), solver: \"soft\", spawn: (count: 30, speed: (0.0, 0.2)))",
+        "drag.ron",
+    )
+    .and_then(|s| s.to_config("drag.ron"))
+    .unwrap();
+    let mut app = create_app(config);
+    step(&mut app, 300);
+    assert!(asleep(&mut app).iter().all(|&s| !s));
+    let registry = app
+        .world()
+        .resource::<moving_circles::effects::EffectRegistry>();
+    assert!(!registry.is_scheduled(Effect::Sleep));
+    // The heap with sleeping off: never asleep.
+    let mut app = heap("soft");
+    app.world_mut().resource_mut::<Effects>().sleep.enabled = false;
+    moving_circles::effects::reconcile_effects(app.world_mut());
+    assert!(until_asleep(&mut app, 5.0).is_none());
+}
