@@ -1,5 +1,7 @@
-//! The force effects: [`GravityPlugin`] (`v += g·dt`) and [`DragPlugin`] (`v *= exp(-drag·dt)`),
-//! in [`CircleSystems::Forces`] before the move, under every solver. Each schedules its system
+//! The force effects: [`GravityPlugin`] (`v += g·dt`, under the discrete solvers; `swept` and
+//! `exact` fly parabolas and `soft` integrates gravity in its substeps) and [`DragPlugin`]
+//! (`v *= exp(-drag·dt)`, under every solver but `soft`, which applies it itself), in
+//! [`CircleSystems::Forces`] before the move. Each schedules its system
 //! only when the scene calls for it (`effects.gravity`, `effects.drag`). Immovable circles
 //! (static and kinematic) and sleeping ones are left alone.
 
@@ -17,14 +19,12 @@ pub struct GravityPlugin;
 
 impl Plugin for GravityPlugin {
     fn build(&self, app: &mut App) {
-        // Forces change velocity before the move (semi-implicit Euler), so they run in both the
-        // discrete substep and the continuous step.
-        register_effect(
-            app,
-            Effect::Gravity,
-            &[CircleStep.intern(), ContinuousStep.intern()],
-            || apply_gravity.in_set(CircleSystems::Forces).into_configs(),
-        );
+        // Gravity changes velocity before the move (semi-implicit Euler) in the discrete
+        // substep; the event engine flies its parabolas exactly, and the soft solver integrates
+        // it in its own substeps.
+        register_effect(app, Effect::Gravity, &[CircleStep.intern()], || {
+            apply_gravity.in_set(CircleSystems::Forces).into_configs()
+        });
     }
 }
 

@@ -14,8 +14,10 @@
 //! change-tick check and one write per circle, not for comparing every circle's values.
 
 pub mod engine;
+pub mod fall;
 pub mod pack;
 pub mod queue;
+pub mod roots;
 pub mod toi;
 
 use bevy::ecs::entity::EntityHashMap;
@@ -27,12 +29,13 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::CircleState;
 use crate::collide::PairCollisions;
-use crate::components::{Mass, Position, Radius, Restitution, SolverCircles, Velocity};
+use crate::components::{Mass, Position, Radius, Restitution, Sleep, SolverCircles, Velocity};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
 use crate::segment::Segments;
-use engine::{EngineSnapshot, EventEngine, EventStats};
+use crate::sleep::Sleeping;
+use engine::{EngineSnapshot, EventEngine, EventStats, Rest};
 
 /// Events a `swept` step may process per circle before the rest of the step is free flight.
 pub const SWEPT_EVENTS_PER_CIRCLE: u64 = 64;
@@ -110,8 +113,8 @@ impl EngineState {
             &states,
             &arena,
             &segments.0,
-            effects.restitution,
-            effects.wall_restitution,
+            (effects.restitution, effects.wall_restitution),
+            effects.gravity.unwrap_or_default(),
         )?;
         engine.record_hits(effects.hit_messages);
         if let Some(i) = (0..engine.len()).find(|&i| engine.position(i) != states[i].position) {
@@ -156,6 +159,14 @@ type ChangedCircles<'w, 's> = Query<
     ),
 >;
 
+/// What the continuous step counts: hits of each kind, and the circles asleep.
+#[derive(SystemParam)]
+struct Counted<'w> {
+    pairs: ResMut<'w, PairCollisions>,
+    walls: ResMut<'w, WallCollisions>,
+    sleeping: ResMut<'w, Sleeping>,
+}
+
 /// What the engine is built for and how far a step takes it.
 #[derive(SystemParam)]
 struct StepSetup<'w> {
@@ -173,8 +184,8 @@ fn continuous_step(
     mut state: ResMut<EngineState>,
     own_restitution: Query<(), With<Restitution>>,
     mut lost_restitution: RemovedComponents<Restitution>,
-    mut circles: ParamSet<(SolverCircles, ChangedCircles)>,
-    counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
+    mut circles: ParamSet<(SolverCircles, ChangedCircles, Query<&mut Sleep>)>,
+    mut counted: Counted,
     messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
 ) {
     let StepSetup {
@@ -193,8 +204,44 @@ fn continuous_step(
         (restitution_lost, with_own_restitution),
         &mut circles,
     );
-    advance_engine(*solver, dt.0, &mut state, counted, messages);
+    advance_engine(
+        *solver,
+        dt.0,
+        &mut state,
+        (&mut counted.pairs, &mut counted.walls),
+        messages,
+    );
     write_back(&mut state, &mut circles.p0());
+    counted.sleeping.count = write_back_sleep(&state, &mut circles.p2());
+}
+
+/// Writes each circle's rest back to its [`Sleep`] (in the engine's order), for the next engine
+/// `swept` builds and for checkpoints, and returns how many circles sleep. Only under gravity:
+/// without it nothing rests.
+fn write_back_sleep(state: &EngineState, sleep: &mut Query<&mut Sleep>) -> usize {
+    let Some(engine) = state.engine.as_ref() else {
+        return 0;
+    };
+    let falling = matches!(state.setup, Some((_, effects, _)) if effects.gravity.is_some());
+    if !falling {
+        return 0;
+    }
+    let mut asleep = 0;
+    for (i, &entity) in state.entities.iter().enumerate() {
+        let rest = engine.rest(i);
+        asleep += usize::from(rest.asleep);
+        let now = Sleep {
+            anchor: rest.anchor,
+            slow_for: rest.resting_for,
+            asleep: rest.asleep,
+        };
+        if let Ok(mut s) = sleep.get_mut(entity)
+            && *s != now
+        {
+            *s = now;
+        }
+    }
+    asleep
 }
 
 /// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
@@ -206,7 +253,7 @@ fn gather_into_engine(
     setup: (Solver, Arena, Effects, &Segments),
     state: &mut EngineState,
     restitution: (bool, bool),
-    circles: &mut ParamSet<(SolverCircles, ChangedCircles)>,
+    circles: &mut ParamSet<(SolverCircles, ChangedCircles, Query<&mut Sleep>)>,
 ) {
     let (solver, arena, effects, segments) = setup;
     let (restitution_lost, with_own_restitution) = restitution;
@@ -253,13 +300,19 @@ fn gather_into_engine(
         .iter()
         .map(|(_, p, v, r, m, ..)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
         .collect();
-    let mut engine = EventEngine::new(
-        &bodies,
-        &arena,
-        &segments.0,
-        effects.restitution,
-        effects.wall_restitution,
-    );
+    let rest: Vec<Rest> = all
+        .iter()
+        .map(|c| Rest {
+            asleep: c.6.asleep,
+            anchor: c.6.anchor,
+            resting_for: c.6.slow_for,
+        })
+        .collect();
+    let restitutions = (effects.restitution, effects.wall_restitution);
+    let mut engine = match effects.gravity {
+        Some(g) => EventEngine::falling(&bodies, &arena, &segments.0, restitutions, g, &rest),
+        None => EventEngine::new(&bodies, &arena, &segments.0, restitutions.0, restitutions.1),
+    };
     if with_own_restitution {
         engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());
     }
@@ -311,7 +364,7 @@ fn advance_engine(
     solver: Solver,
     dt: f64,
     state: &mut EngineState,
-    mut counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
+    counted: (&mut PairCollisions, &mut WallCollisions),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
 ) {
     let Some(engine) = state.engine.as_mut() else {
@@ -333,7 +386,7 @@ fn advance_engine(
         log.send_circle_hits(entity, -t_start, &mut messages.0);
         log.send_wall_hits(entity, -t_start, &mut messages.1);
     }
-    let (pairs, walls) = &mut counted;
+    let (pairs, walls) = counted;
     let stats = engine.stats();
     let last = std::mem::replace(&mut state.last_stats, stats);
     pairs.count += stats.pair_collisions - last.pair_collisions;

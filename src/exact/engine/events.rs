@@ -79,6 +79,19 @@ pub(super) const NO_PAIR: BestPair = BestPair {
     partner_count: 0,
 };
 
+/// Where a circle stands in coming to rest under gravity, carried from one engine to the next
+/// (`swept` builds one every step): whether it sleeps, and the place it has stayed near while
+/// bouncing its least bounce, for how long.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Rest {
+    /// Whether it sleeps.
+    pub asleep: bool,
+    /// Where it last moved to.
+    pub anchor: DVec2,
+    /// Seconds it has stayed near there.
+    pub resting_for: f64,
+}
+
 /// Why [`EventEngine::advance_to`](super::EventEngine::advance_to) stopped early.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BudgetExhausted {

@@ -196,8 +196,15 @@ mod tests {
                 ..*c
             })
             .collect();
-        let mut restored =
-            EventEngine::restore(original.snapshot(), &now, &arena, &[], 1.0, 1.0).unwrap();
+        let mut restored = EventEngine::restore(
+            original.snapshot(),
+            &now,
+            &arena,
+            &[],
+            (1.0, 1.0),
+            DVec2::ZERO,
+        )
+        .unwrap();
         original.advance_to(3.0, u64::MAX).unwrap();
         restored.advance_to(3.0, u64::MAX).unwrap();
         assert_eq!(restored.snapshot(), original.snapshot());

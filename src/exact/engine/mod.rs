@@ -1,12 +1,14 @@
-//! The event-driven engine: circles fly in straight lines between events, and events (pair
-//! collisions, wall hits, segment wall hits, cell crossings) are processed in time order.
+//! The event-driven engine: circles fly in straight lines between events (parabolas under
+//! gravity), and events (pair collisions, wall hits, segment wall hits, cell crossings) are
+//! processed in time order.
 //!
 //! Each circle has exactly one pending event, its soonest, held in an indexed [`EventQueue`].
 //! A pair event remembers its partner's collision counter; if the partner has collided since,
 //! the event is stale, and since nothing can have happened to the owner before it, the owner is
 //! simply predicted again from that moment (`predict`).
 //!
-//! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)`, its reference point
+//! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)` (plus `½g(t - t_at)²`
+//! if it falls), its reference point
 //! moved only where its course changes, and every event time is worked out from reference
 //! points, so the run does not depend on the cells. A [`Grid`] of cells sized to the density
 //! (`walls::cell_width`) and at least one diameter of every circle in them wide, with
@@ -15,16 +17,20 @@
 //! bumps no counter (events other circles hold with the crosser stay valid). Segment walls are
 //! listed in the cells they pass within a largest radius of ([`SegmentCells`]), so a circle
 //! looks only at its own cell's list, again after each crossing. In a compression the radii
-//! grow as the circles fly (`growth`). Everything is f64.
+//! grow as the circles fly (`growth`). Under gravity, circles at rest on a support sleep and
+//! are woken by a hard hit (`rest`). Everything is f64.
 
 mod events;
 mod growth;
 mod large;
+mod motion;
+mod pairs;
 mod predict;
+mod rest;
 mod snapshot;
 mod walls;
 
-pub use events::{BudgetExhausted, EventStats};
+pub use events::{BudgetExhausted, EventStats, Rest};
 pub use snapshot::EngineSnapshot;
 
 use events::{BestPair, Event, Kind, Motion, NO_PAIR};
@@ -33,14 +39,10 @@ use walls::{Layout, cell_width, walls_inside};
 use bevy::math::DVec2;
 
 use super::queue::EventQueue;
-use crate::arena::{Arena, minimum_image};
-use crate::boundary::reflect_off_walls;
+use crate::arena::Arena;
 use crate::circle::CircleState;
-use crate::collide::contact::{
-    apply_impulse, combine_restitution, contact_normal, work_by_immovable,
-};
 use crate::grid::{CellMembers, Grid, NONE};
-use crate::hits::{CircleHit, HitLog};
+use crate::hits::HitLog;
 use crate::segment::{Segment, SegmentCells};
 
 /// An event-driven simulation of circles.
@@ -95,6 +97,18 @@ pub struct EventEngine {
     /// own each looks at.
     large: Vec<u32>,
     reach: Vec<u32>,
+    /// The acceleration of every falling circle (zero without gravity).
+    gravity: DVec2,
+    /// Whether each circle falls: movable, awake, under gravity.
+    falls: Vec<bool>,
+    /// Whether each circle sleeps: at rest on a support, immovable until a hard hit wakes it.
+    asleep: Vec<bool>,
+    /// When each circle was last hit (under gravity, for the contact time).
+    last_hit: Vec<f64>,
+    /// How many hits in a row each circle took within its contact time of the one before.
+    quick_hits: Vec<u32>,
+    /// Where each circle last moved to, and when, while it bounces its least bounce.
+    anchor: Vec<(DVec2, f64)>,
 }
 
 impl EventEngine {
@@ -119,8 +133,58 @@ impl EventEngine {
         )
     }
 
+    /// [`EventEngine::new`] under `gravity`: movable circles fly parabolas, and each starts with
+    /// its [`Rest`] in `rest` (one per circle, or none: all awake, not at rest). A circle whose bounce on a support
+    /// (a wall, a segment wall, an immovable or sleeping circle) dies down falls asleep; a
+    /// sleeping circle wakes when hit hard, or when [`EventEngine::set_motion`] moves it.
+    pub fn falling(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        (restitution, wall_restitution): (f64, f64),
+        gravity: DVec2,
+        rest: &[Rest],
+    ) -> Self {
+        let width = cell_width(arena, circles);
+        let mut engine = Self::lay_out(
+            circles,
+            arena,
+            segments,
+            (restitution, wall_restitution),
+            width,
+        );
+        engine.gravity = gravity;
+        for i in 0..engine.len() {
+            let at_rest = rest.get(i).copied().unwrap_or_default();
+            engine.asleep[i] = at_rest.asleep;
+            engine.anchor[i] = (at_rest.anchor, -at_rest.resting_for);
+            if engine.asleep[i] {
+                engine.motion[i].vel = DVec2::ZERO;
+            }
+            engine.falls[i] = engine.can_fall(i);
+        }
+        engine.relink_all();
+        engine.predict_all();
+        engine
+    }
+
     /// [`EventEngine::new`] on cells at least `width` wide (and a largest diameter).
     fn with_cells(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        restitutions: (f64, f64),
+        width: f64,
+    ) -> Self {
+        let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
+        engine.relink_all();
+        engine.predict_all();
+        engine
+    }
+
+    /// The engine's state for `circles` at time 0, before any circle is put in a cell or
+    /// predicted.
+    fn lay_out(
         circles: &[CircleState],
         arena: &Arena,
         segments: &[Segment],
@@ -136,7 +200,7 @@ impl EventEngine {
             large,
             reach,
         } = walls_inside(arena, circles, segments, width);
-        let mut engine = Self {
+        Self {
             arena: *arena,
             period: size,
             restitution,
@@ -179,10 +243,13 @@ impl EventEngine {
             growth: 0.0,
             large,
             reach,
-        };
-        engine.relink_all();
-        engine.predict_all();
-        engine
+            gravity: DVec2::ZERO,
+            falls: vec![false; n],
+            asleep: vec![false; n],
+            last_hit: vec![f64::NEG_INFINITY; n],
+            quick_hits: vec![0; n],
+            anchor: vec![(DVec2::INFINITY, 0.0); n],
+        }
     }
 
     /// Gives each circle its own restitution (one value per circle, in order; empty: all take
@@ -212,6 +279,8 @@ impl EventEngine {
         } else {
             position
         };
+        self.asleep[i] = false;
+        self.falls[i] = self.can_fall(i);
         self.motion[i].pos = position;
         self.motion[i].vel = velocity;
         self.motion[i].t_at = self.now;
@@ -251,13 +320,28 @@ impl EventEngine {
     /// Position of circle `i` now (inside a periodic arena).
     #[inline]
     pub fn position(&self, i: usize) -> DVec2 {
-        self.inside(self.motion[i].at(self.now))
+        self.inside(self.pos_at(i, self.now))
     }
 
-    /// Velocity of circle `i`.
+    /// Velocity of circle `i` now.
     #[inline]
     pub fn velocity(&self, i: usize) -> DVec2 {
-        self.motion[i].vel
+        self.vel_at(i, self.now)
+    }
+
+    /// Whether circle `i` sleeps.
+    pub fn is_asleep(&self, i: usize) -> bool {
+        self.asleep[i]
+    }
+
+    /// Circle `i`'s [`Rest`] now: what a fresh engine needs to go on resting it.
+    pub fn rest(&self, i: usize) -> Rest {
+        let (anchor, since) = self.anchor[i];
+        Rest {
+            asleep: self.asleep[i],
+            anchor,
+            resting_for: (self.now - since).max(0.0),
+        }
     }
 
     /// What circle `i` was built with: radius, inverse mass and the restitution it bounces
@@ -305,60 +389,6 @@ impl EventEngine {
         Ok(processed)
     }
 
-    /// Moves every circle in a straight line to `t` without processing events (walls fold the
-    /// motion back inside, periodic edges wrap), then predicts afresh. The fallback when a step's
-    /// event budget runs out: collisions skipped here show up as overlapping, approaching pairs,
-    /// which collide at once on the next advance.
-    pub fn drift_to(&mut self, t: f64) {
-        let arena = self.arena;
-        let scale = 1.0 + self.growth * t;
-        for (m, count) in self.motion.iter_mut().zip(&mut self.counter) {
-            let mut p = m.at(t);
-            if arena.is_periodic() {
-                p = arena.wrap(p);
-            } else {
-                let r = m.radius * scale;
-                reflect_off_walls(&mut p, &mut m.vel, r, &arena, self.wall_restitution);
-            }
-            m.pos = p;
-            m.t_at = t;
-            *count += 1;
-        }
-        self.now = t;
-        self.relink_all();
-        self.predict_all();
-    }
-
-    /// Moves circle `i`'s reference point to time `t`, where its course is about to change
-    /// (inside a periodic arena). Crossings never move it: only events that every grid of cells
-    /// shares do, so the trajectories do not depend on the grid.
-    fn advance_circle(&mut self, i: usize, t: f64) {
-        let p = self.motion[i].at(t);
-        self.motion[i].pos = self.inside(p);
-        self.motion[i].t_at = t;
-    }
-
-    /// `p`, or on a periodic arena its image in `[min, max)`.
-    #[inline]
-    fn inside(&self, p: DVec2) -> DVec2 {
-        let arena = &self.arena;
-        if self.grid.periodic && !(p.cmpge(arena.min).all() && p.cmplt(arena.max).all()) {
-            arena.wrap(p)
-        } else {
-            p
-        }
-    }
-
-    /// The displacement from `a` to `b` (minimum image on a periodic arena).
-    #[inline]
-    fn offset(&self, a: DVec2, b: DVec2) -> DVec2 {
-        if self.grid.periodic {
-            minimum_image(b - a, self.period)
-        } else {
-            b - a
-        }
-    }
-
     fn cell_index(&self, i: usize) -> usize {
         self.grid
             .index(self.cell_x[i] as usize, self.cell_y[i] as usize)
@@ -376,49 +406,6 @@ impl EventEngine {
                 self.cells.insert(i, self.grid.index(x, y));
             }
         }
-    }
-
-    fn collide(&mut self, i: usize, j: usize) {
-        let now = self.now;
-        self.advance_circle(i, now);
-        self.advance_circle(j, now);
-        let (a, b) = (self.motion[i], self.motion[j]);
-        let (n, _) = contact_normal(self.offset(a.pos, b.pos), a.vel - b.vel);
-        let (mut va, mut vb) = (a.vel, b.vel);
-        let (wa, wb) = (self.inv_mass[i], self.inv_mass[j]);
-        let e = match self.own_restitution.as_slice() {
-            [] => self.restitution,
-            own => combine_restitution(own[i], own[j]),
-        };
-        // Growing radii bounce as if `b` came in slower by the rate the surfaces close at.
-        let surfaces = n * ((a.radius + b.radius) * self.growth);
-        vb -= surfaces;
-        if let Some(impulse) = apply_impulse(n, &mut va, &mut vb, wa, wb, e) {
-            self.motion[i].vel = va;
-            self.motion[j].vel = vb + surfaces;
-            self.stats.pair_collisions += 1;
-            self.stats.virial += (a.radius + b.radius) * impulse;
-            if wa == 0.0 || wb == 0.0 {
-                let (work, gained) = work_by_immovable((wa, wb), (a.vel, va), (b.vel, vb));
-                self.stats.immovable_work += work;
-                self.stats.immovable_impulse += gained;
-            }
-            if let Some(log) = &mut self.hits {
-                log.circles.push(CircleHit {
-                    a: i as u32,
-                    b: j as u32,
-                    point: a.pos + n * a.radius,
-                    normal: n,
-                    impulse,
-                    normal_speed: (a.vel - b.vel).dot(n),
-                    time: now,
-                });
-            }
-        }
-        self.counter[i] += 1;
-        self.counter[j] += 1;
-        self.predict(i);
-        self.predict(j);
     }
 
     /// Moves circle `i` into the next cell along `axis` (past a periodic edge, the first cell

@@ -7,11 +7,19 @@
 //! pair from before if that partner has not changed. So whenever a pair becomes neighbours, the
 //! one that moved looks at the other. A large circle does the same over the block of cells its
 //! radius reaches ([`super::large`]).
+//!
+//! Under gravity the same is done for parabolas: two falling circles still close at a constant
+//! velocity, so a pair of them takes the straight-line time of impact; a falling circle against
+//! one that does not fall takes the quartic of [`crate::exact::fall`], and walls, segment walls
+//! and cell edges the parabola's roots. A sleeping circle is at rest: it predicts its pairs
+//! with the circles that fly (the pair a circle falling asleep may now have with a neighbour is
+//! found that way), and no wall or cell event.
 
 use bevy::math::DVec2;
 
 use super::EventEngine;
 use super::events::{BestPair, Event, Kind, Motion, NO_PAIR};
+use crate::exact::fall::{exit_time, falling_pair_time, falling_segment_time};
 use crate::exact::toi::{
     growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact, wall_time_of_impact,
 };
@@ -21,21 +29,74 @@ impl EventEngine {
     /// The soonest collision of circle `i` with a circle in `cells` or a large circle, not
     /// before now.
     pub(super) fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
+        if self.gravity == DVec2::ZERO {
+            self.scan_with::<false>(i, cells)
+        } else {
+            self.scan_with::<true>(i, cells)
+        }
+    }
+
+    /// [`EventEngine::scan`], with the parabolas of gravity when `FALL` (a separate loop, so
+    /// that the straight-line one is exactly what it is without gravity).
+    fn scan_with<const FALL: bool>(
+        &self,
+        i: usize,
+        cells: impl IntoIterator<Item = usize>,
+    ) -> BestPair {
         let me = self.motion[i];
         let mut best = NO_PAIR;
+        let mut look = |j: usize| {
+            if FALL {
+                self.look_falling(i, j, &mut best);
+            } else {
+                self.look_at(&me, j, &mut best);
+            }
+        };
         for c in cells {
             for j in self.cells.members(c) {
                 if j != i {
-                    self.look_at(&me, j, &mut best);
+                    look(j);
                 }
             }
         }
         for &j in &self.large {
             if j as usize != i {
-                self.look_at(&me, j as usize, &mut best);
+                look(j as usize);
             }
         }
         best
+    }
+
+    /// [`EventEngine::look_at`] under gravity: the pair's positions and velocities at the later
+    /// of their reference times on their own courses, and the quartic when only one falls.
+    fn look_falling(&self, i: usize, j: usize, best: &mut BestPair) {
+        let (me, other) = (&self.motion[i], &self.motion[j]);
+        let now = self.now;
+        let since = me.t_at.max(other.t_at);
+        let mut dp = self.pos_at(j, since) - self.pos_at(i, since);
+        let dv = self.vel_at(j, since) - self.vel_at(i, since);
+        let da = self.acceleration(j) - self.acceleration(i);
+        if self.grid.periodic {
+            let tau = now - since;
+            let d = dp + dv * tau + 0.5 * da * (tau * tau);
+            dp.x -= whole_periods(d.x, self.period.x);
+            dp.y -= whole_periods(d.y, self.period.y);
+        }
+        let sum = me.radius + other.radius;
+        let impact = if da == DVec2::ZERO {
+            pair_time_of_impact(dp, dv, sum)
+        } else {
+            falling_pair_time(dp, dv, da, sum)
+        };
+        if let Some(t) = impact
+            && (since + t).max(now) < best.time
+        {
+            *best = BestPair {
+                time: (since + t).max(now),
+                partner: j as u32,
+                partner_count: self.counter[j],
+            };
+        }
     }
 
     /// Keeps in `best` the sooner of it and the collision of the circle moving as `me` with
@@ -161,9 +222,15 @@ impl EventEngine {
                 };
             }
         };
+        let acc = self.acceleration(i);
         for &k in self.segment_cells.in_cell(self.cell_index(i)) {
             let segment = &self.segments[k as usize];
-            if let Some(t) = segment_time_of_impact(p, m.vel, m.radius, segment) {
+            let hit = if acc == DVec2::ZERO {
+                segment_time_of_impact(p, m.vel, m.radius, segment)
+            } else {
+                falling_segment_time(p, m.vel, acc, m.radius, segment)
+            };
+            if let Some(t) = hit {
                 consider(t, Kind::Segment, k);
             }
         }
@@ -176,6 +243,17 @@ impl EventEngine {
         for axis in 0..2u8 {
             let a = axis as usize;
             let v = m.vel[a];
+            if acc[a] != 0.0 {
+                // Under gravity: the parabola's roots, through walls and cell edges alike.
+                let (lo, hi) = (min[a] + r, max[a] - r);
+                if walls && let Some((t, _)) = exit_time(p[a], v, acc[a], lo, hi) {
+                    consider(t, Kind::Wall { axis }, NONE);
+                }
+                if let Some((t, up)) = self.cell_exit(i, a, acc[a]) {
+                    consider(t, Kind::Cell { axis, up }, NONE);
+                }
+                continue;
+            }
             if walls
                 && let Some((t, _)) = wall_time_of_impact(p[a], v, min[a] + r, max[a] - r, growth)
             {
@@ -208,6 +286,35 @@ impl EventEngine {
         }
         self.event[i] = event;
         self.queue.set(i, time);
+    }
+
+    /// When falling circle `i` (acceleration `acc` along axis `a`) leaves its cell along `a`,
+    /// and whether upwards: none through the outer edges of a walled box, nor where one cell
+    /// spans a period. Times count from its reference time, but the exit is found from where
+    /// it is now: crossings do not move the reference point, which may lie cells behind, and a
+    /// parabola from there may leave the cell's span before it ever reaches the cell.
+    fn cell_exit(&self, i: usize, a: usize, acc: f64) -> Option<(f64, bool)> {
+        let m = &self.motion[i];
+        let (x, v) = (self.pos_at(i, self.now)[a], self.vel_at(i, self.now)[a]);
+        let (cell, last) = if a == 0 {
+            (self.cell_x[i] as usize, self.grid.cols - 1)
+        } else {
+            (self.cell_y[i] as usize, self.grid.rows - 1)
+        };
+        if last == 0 {
+            return None;
+        }
+        let walls = !self.grid.periodic;
+        let (mut lo, mut hi) = (self.grid.edge(a, cell), self.grid.edge(a, cell + 1));
+        if !walls {
+            // The cell's image the circle is in now (see `schedule`).
+            let middle = lo + 0.5 * self.grid.cell[a];
+            let shift = whole_periods(x - middle, self.period[a]);
+            (lo, hi) = (lo + shift, hi + shift);
+        }
+        let (t, up) = exit_time(x, v, acc, lo, hi)?;
+        let outer = walls && ((up && cell == last) || (!up && cell == 0));
+        (!outer).then_some((self.now - m.t_at + t, up))
     }
 
     pub(super) fn predict_all(&mut self) {

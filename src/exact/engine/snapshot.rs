@@ -4,6 +4,7 @@
 //! error instead of a panic. What follows from the circles and the arena (inverse masses, the
 //! grid, the queue's blocks and lists) is rebuilt, not stored.
 
+use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::events::{BestPair, Event, EventStats, Kind, Motion};
@@ -28,6 +29,10 @@ pub struct EngineSnapshot {
     cell_x: Vec<u32>,
     cell_y: Vec<u32>,
     stats: EventStats,
+    asleep: Vec<bool>,
+    last_hit: Vec<f64>,
+    quick_hits: Vec<u32>,
+    anchor: Vec<(DVec2, f64)>,
 }
 
 impl EventEngine {
@@ -44,19 +49,24 @@ impl EventEngine {
             cell_x: self.cell_x.clone(),
             cell_y: self.cell_y.clone(),
             stats: self.stats,
+            asleep: self.asleep.clone(),
+            last_hit: self.last_hit.clone(),
+            quick_hits: self.quick_hits.clone(),
+            anchor: self.anchor.clone(),
         }
     }
 
     /// The engine `snapshot` was taken of, given the same `circles` (radii and masses; their
-    /// positions and velocities are the snapshot's), arena and restitutions it was built with.
-    /// Refuses, saying why, a snapshot that does not fit them or is inconsistent in itself.
+    /// positions and velocities are the snapshot's), arena, restitutions and gravity it was
+    /// built with. Refuses, saying why, a snapshot that does not fit them or is inconsistent in
+    /// itself.
     pub fn restore(
         snapshot: EngineSnapshot,
         circles: &[CircleState],
         arena: &Arena,
         segments: &[Segment],
-        restitution: f64,
-        wall_restitution: f64,
+        (restitution, wall_restitution): (f64, f64),
+        gravity: DVec2,
     ) -> Result<Self, String> {
         let n = circles.len();
         let s = snapshot;
@@ -68,6 +78,10 @@ impl EventEngine {
             s.best_pair.len(),
             s.cell_x.len(),
             s.cell_y.len(),
+            s.asleep.len(),
+            s.last_hit.len(),
+            s.quick_hits.len(),
+            s.anchor.len(),
         ];
         if lengths.iter().any(|&l| l != n) {
             return Err(format!(
@@ -89,11 +103,25 @@ impl EventEngine {
         let partner_ok = |p: u32, i: usize| p == NONE || (p as usize) < n && p as usize != i;
         for (i, c) in circles.iter().enumerate() {
             let m = &s.motion[i];
+            // A falling circle's velocity now is its reference velocity plus what gravity
+            // gave it since; a sleeper is at rest.
+            let falls = gravity != DVec2::ZERO && c.inv_mass() > 0.0 && !s.asleep[i];
+            let velocity = if falls {
+                m.vel + gravity * (s.now - m.t_at)
+            } else {
+                m.vel
+            };
             let fits = m.pos.is_finite()
                 && m.vel.is_finite()
                 && m.t_at.is_finite()
+                && m.t_at <= s.now
+                && !s.last_hit[i].is_nan()
+                && !s.anchor[i].0.is_nan()
+                && s.anchor[i].1.is_finite()
+                && s.last_hit[i] <= s.now
                 && m.radius == c.radius
-                && m.vel == c.velocity;
+                && velocity == c.velocity
+                && !(s.asleep[i] && (m.vel != DVec2::ZERO || c.inv_mass() == 0.0));
             let event = s.event[i];
             let kind_ok = match event.kind {
                 Kind::Idle => s.time[i] == f64::INFINITY,
@@ -119,6 +147,10 @@ impl EventEngine {
             (!large.contains(&(i as u32))).then_some(cell)
         };
         s.cells.check(grid.len(), n, cell_of)?;
+        let inv_mass: Vec<f64> = circles.iter().map(CircleState::inv_mass).collect();
+        let falls = (0..n)
+            .map(|i| gravity != DVec2::ZERO && inv_mass[i] > 0.0 && !s.asleep[i])
+            .collect();
         Ok(Self {
             arena: *arena,
             period: size,
@@ -126,7 +158,7 @@ impl EventEngine {
             wall_restitution,
             now: s.now,
             motion: s.motion,
-            inv_mass: circles.iter().map(CircleState::inv_mass).collect(),
+            inv_mass,
             counter: s.counter,
             event: s.event,
             best_pair: s.best_pair,
@@ -143,6 +175,12 @@ impl EventEngine {
             growth: 0.0,
             large,
             reach,
+            gravity,
+            falls,
+            asleep: s.asleep,
+            last_hit: s.last_hit,
+            quick_hits: s.quick_hits,
+            anchor: s.anchor,
         })
     }
 }
@@ -184,8 +222,15 @@ mod tests {
         let mut original = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         original.advance_to(1.0, u64::MAX).unwrap();
         let now = circles_now(&original, &circles);
-        let mut restored =
-            EventEngine::restore(original.snapshot(), &now, &arena, &[], 1.0, 1.0).unwrap();
+        let mut restored = EventEngine::restore(
+            original.snapshot(),
+            &now,
+            &arena,
+            &[],
+            (1.0, 1.0),
+            DVec2::ZERO,
+        )
+        .unwrap();
         original.advance_to(5.0, u64::MAX).unwrap();
         restored.advance_to(5.0, u64::MAX).unwrap();
         assert!(original.stats().pair_collisions > 50);
@@ -224,10 +269,10 @@ mod tests {
             let mut bad = good.clone();
             damage(&mut bad);
             assert!(
-                EventEngine::restore(bad, &now, &arena, &[], 1.0, 1.0).is_err(),
+                EventEngine::restore(bad, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_err(),
                 "damage {k} was accepted"
             );
         }
-        assert!(EventEngine::restore(good, &now, &arena, &[], 1.0, 1.0).is_ok());
+        assert!(EventEngine::restore(good, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_ok());
     }
 }

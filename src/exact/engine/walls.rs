@@ -22,6 +22,7 @@ impl EventEngine {
             [] => self.wall_restitution,
             own => combine_restitution(own[i], self.wall_restitution),
         };
+        let bounce = self.contact_time_restitution(&[i], e);
         let scale = 1.0 + self.growth * self.now;
         let m = &mut self.motion[i];
         let (r, growth) = (m.radius * scale, m.radius * self.growth);
@@ -29,16 +30,22 @@ impl EventEngine {
         let v = m.vel[axis];
         // Snap onto the wall (the event time puts it there up to rounding) and reflect, off a
         // wall that closes in at the rate the radius grows in a compression.
-        let high = if growth == 0.0 {
+        // Which wall: the way it moves, or (at rest against a wall under gravity, or growing)
+        // the nearer one.
+        let high = if growth == 0.0 && v != 0.0 {
             v > 0.0
         } else {
             hi - m.pos[axis] < m.pos[axis] - lo
         };
         m.pos[axis] = if high { hi } else { lo };
         let wall_v = if high { -growth } else { growth };
-        let new_v = wall_v - e * (v - wall_v);
+        let new_v = wall_v - bounce * (v - wall_v);
         m.vel[axis] = new_v;
         let centre = m.pos;
+        let mut normal = bevy::math::DVec2::ZERO;
+        normal[axis] = if high { 1.0 } else { -1.0 };
+        self.rest_on_support(i, normal, e);
+        self.sleep_if_jammed(i);
         let impulse = self.count_wall_hit(i, (new_v - v).abs());
         if let Some(log) = &mut self.hits {
             let wall = ArenaWall::on_axis(axis, high);
@@ -79,6 +86,7 @@ impl EventEngine {
             [] => self.wall_restitution,
             own => combine_restitution(own[i], self.wall_restitution),
         };
+        let bounce = self.contact_time_restitution(&[i], e);
         let segment = self.segments[k];
         let m = &mut self.motion[i];
         let (point, out, _) = segment.contact(m.pos, m.vel);
@@ -87,7 +95,7 @@ impl EventEngine {
             // Snap to touching (the event time puts it there up to rounding) and reflect.
             m.pos = point + out * m.radius;
             let before = m.vel;
-            m.vel -= out * ((1.0 + e) * vn);
+            m.vel -= out * ((1.0 + bounce) * vn);
             let speed_change = (m.vel - before).length();
             let impulse = self.count_wall_hit(i, speed_change);
             if let Some(log) = &mut self.hits {
@@ -103,6 +111,9 @@ impl EventEngine {
                 });
             }
         }
+        // Pressed against the wall by gravity with no speed, or bounced off it weakly: rest.
+        self.rest_on_support(i, -out, e);
+        self.sleep_if_jammed(i);
         self.counter[i] += 1;
         self.predict(i);
     }

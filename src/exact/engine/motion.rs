@@ -1,0 +1,100 @@
+//! Where a circle is on its course: in a straight line, or on a parabola when it falls, from
+//! its reference point (`pos_at`, `vel_at`), moved there only where its course changes
+//! (`advance_circle`); and the fallback that moves every circle along its course without
+//! events when a step's budget runs out (`drift_to`).
+
+use bevy::math::DVec2;
+
+use super::EventEngine;
+use crate::arena::minimum_image;
+use crate::boundary::reflect_off_walls;
+
+impl EventEngine {
+    /// Where circle `i` is at time `t` on its current course (not wrapped).
+    #[inline]
+    pub(super) fn pos_at(&self, i: usize, t: f64) -> DVec2 {
+        let m = &self.motion[i];
+        if self.falls[i] {
+            let tau = t - m.t_at;
+            m.pos + m.vel * tau + 0.5 * self.gravity * (tau * tau)
+        } else {
+            m.at(t)
+        }
+    }
+
+    /// Circle `i`'s velocity at time `t` on its current course.
+    #[inline]
+    pub(super) fn vel_at(&self, i: usize, t: f64) -> DVec2 {
+        let m = &self.motion[i];
+        if self.falls[i] {
+            m.vel + self.gravity * (t - m.t_at)
+        } else {
+            m.vel
+        }
+    }
+
+    /// Circle `i`'s acceleration on its current course.
+    #[inline]
+    pub(super) fn acceleration(&self, i: usize) -> DVec2 {
+        if self.falls[i] {
+            self.gravity
+        } else {
+            DVec2::ZERO
+        }
+    }
+
+    /// Moves every circle in a straight line to `t` without processing events (walls fold the
+    /// motion back inside, periodic edges wrap), then predicts afresh. The fallback when a step's
+    /// event budget runs out: collisions skipped here show up as overlapping, approaching pairs,
+    /// which collide at once on the next advance.
+    pub fn drift_to(&mut self, t: f64) {
+        let arena = self.arena;
+        let scale = 1.0 + self.growth * t;
+        for i in 0..self.len() {
+            let (mut p, mut v) = (self.pos_at(i, t), self.vel_at(i, t));
+            let m = &mut self.motion[i];
+            if arena.is_periodic() {
+                p = arena.wrap(p);
+            } else {
+                let r = m.radius * scale;
+                reflect_off_walls(&mut p, &mut v, r, &arena, self.wall_restitution);
+            }
+            (m.pos, m.vel, m.t_at) = (p, v, t);
+            self.counter[i] += 1;
+        }
+        self.now = t;
+        self.relink_all();
+        self.predict_all();
+    }
+
+    /// Moves circle `i`'s reference point to time `t`, where its course is about to change
+    /// (inside a periodic arena). Crossings never move it: only events that every grid of cells
+    /// shares do, so the trajectories do not depend on the grid.
+    pub(super) fn advance_circle(&mut self, i: usize, t: f64) {
+        let (p, v) = (self.pos_at(i, t), self.vel_at(i, t));
+        self.motion[i].pos = self.inside(p);
+        self.motion[i].vel = v;
+        self.motion[i].t_at = t;
+    }
+
+    /// `p`, or on a periodic arena its image in `[min, max)`.
+    #[inline]
+    pub(super) fn inside(&self, p: DVec2) -> DVec2 {
+        let arena = &self.arena;
+        if self.grid.periodic && !(p.cmpge(arena.min).all() && p.cmplt(arena.max).all()) {
+            arena.wrap(p)
+        } else {
+            p
+        }
+    }
+
+    /// The displacement from `a` to `b` (minimum image on a periodic arena).
+    #[inline]
+    pub(super) fn offset(&self, a: DVec2, b: DVec2) -> DVec2 {
+        if self.grid.periodic {
+            minimum_image(b - a, self.period)
+        } else {
+            b - a
+        }
+    }
+}

@@ -1,0 +1,175 @@
+//! Real roots of the small polynomials times of impact lead to, as plain functions:
+//! [`quadratic_roots`] in the forms that do not cancel, and [`first_entering_root`], the first
+//! time a quartic (a distance squared against a reach squared) falls to zero, found by
+//! splitting the line at its turning points and refining by safeguarded Newton steps.
+
+/// The real roots of `a·τ² + b·τ + c`, smaller first (`None` for a missing one), taken in the
+/// forms that do not cancel.
+pub fn quadratic_roots(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
+    if a == 0.0 {
+        return if b == 0.0 {
+            [None, None]
+        } else {
+            [Some(-c / b), None]
+        };
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 || !disc.is_finite() {
+        return [None, None];
+    }
+    let q = -0.5 * (b + disc.sqrt().copysign(b));
+    let (r1, r2) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
+    let (lo, hi) = if r1 <= r2 { (r1, r2) } else { (r2, r1) };
+    [Some(lo), Some(hi)]
+}
+
+/// The first `τ ≥ 0` at which the polynomial `c` (coefficients from the constant up, degree at
+/// most 4, positive leading coefficient) goes from positive to zero, or starts to fall while at
+/// or below zero: the turning points (roots of its derivative) split `[0, ∞)` into pieces where
+/// it is monotonic, and the first piece that falls from above zero to zero or below holds the
+/// root, or the first that falls from zero or below starts at it.
+pub fn first_entering_root(c: &[f64; 5]) -> Option<f64> {
+    let f = |t: f64| horner(c, t);
+    let derivative = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4]];
+    let mut turns = cubic_roots_after_zero(&derivative);
+    turns.push(f64::INFINITY);
+    let mut from = 0.0;
+    for to in turns {
+        let end = if to.is_finite() { to } else { far_end(c, from) };
+        let (f_from, f_to) = (f(from), f(end));
+        if f_from > 0.0 && f_to <= 0.0 {
+            return Some(refine(c, from, end));
+        }
+        // Touching (or overlapping by rounding) where it turns to approach: a hit there, before
+        // it would sink in.
+        if f_from <= 0.0 && f_to < f_from {
+            return Some(from);
+        }
+        from = end;
+        if !to.is_finite() {
+            break;
+        }
+    }
+    None
+}
+
+/// A point past which the polynomial `c` (positive leading coefficient) only grows, at or
+/// after `from`: Cauchy's bound on its derivative's roots.
+fn far_end(c: &[f64; 5], from: f64) -> f64 {
+    let top = c[4];
+    if top <= 0.0 {
+        return from;
+    }
+    let bound = 1.0
+        + [c[1], 2.0 * c[2], 3.0 * c[3]]
+            .iter()
+            .map(|x| (x / (4.0 * top)).abs())
+            .fold(0.0, f64::max);
+    bound.max(from)
+}
+
+fn horner(c: &[f64], t: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &k| acc * t + k)
+}
+
+/// The real roots `τ > 0` of the cubic `d` (constant first), in increasing order: its own
+/// turning points (a quadratic's roots) split the line into monotonic pieces, each bisected.
+fn cubic_roots_after_zero(d: &[f64; 4]) -> Vec<f64> {
+    let g = |t: f64| horner(d, t);
+    let mut cuts: Vec<f64> = quadratic_roots(3.0 * d[3], 2.0 * d[2], d[1])
+        .into_iter()
+        .flatten()
+        .filter(|&t| t > 0.0 && t.is_finite())
+        .collect();
+    let bound = if d[3] != 0.0 {
+        1.0 + [d[0], d[1], d[2]]
+            .iter()
+            .map(|x| (x / d[3]).abs())
+            .fold(0.0, f64::max)
+    } else if d[2] != 0.0 {
+        1.0 + [d[0], d[1]]
+            .iter()
+            .map(|x| (x / d[2]).abs())
+            .fold(0.0, f64::max)
+    } else if d[1] != 0.0 {
+        1.0 + (d[0] / d[1]).abs()
+    } else {
+        return Vec::new();
+    };
+    cuts.push(bound);
+    let mut roots = Vec::new();
+    let mut from = 0.0;
+    for to in cuts {
+        if to <= from {
+            continue;
+        }
+        let (a, b) = (g(from), g(to));
+        if a == 0.0 && from > 0.0 {
+            roots.push(from);
+        } else if (a < 0.0) != (b < 0.0) && b != 0.0 {
+            roots.push(bisect(|t| horner(d, t), from, to));
+        }
+        from = to;
+    }
+    roots
+}
+
+/// A root of `f` in `[a, b]`, where `f(a)` and `f(b)` differ in sign, by bisection to the last
+/// bit.
+fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    let below = f(a) < 0.0;
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            break;
+        }
+        if (f(m) < 0.0) == below {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    a
+}
+
+/// The first `τ` in `[a, b]` where the polynomial `c`, positive at `a` and not at `b` and
+/// monotonic between, reaches zero: Newton steps, kept inside a shrinking bracket (bisection
+/// whenever a step would leave it), to the last bit. Returns the bracket's upper end, where
+/// the polynomial is zero or below: the contact is then reached, never missed by rounding.
+fn refine(c: &[f64; 5], mut a: f64, mut b: f64) -> f64 {
+    let d = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4]];
+    let mut t = b;
+    for _ in 0..100 {
+        let (ft, dt) = (horner(c, t), horner(&d, t));
+        if ft > 0.0 {
+            a = t;
+        } else {
+            b = t;
+        }
+        let newton = t - ft / dt;
+        t = if newton > a && newton < b && newton.is_finite() {
+            newton
+        } else {
+            0.5 * (a + b)
+        };
+        if t <= a || t >= b {
+            break;
+        }
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadratic_roots_are_exact_for_far_apart_roots() {
+        // τ² − 1e8 τ + 1 = 0: roots 1e-8 and 1e8; the naive formula loses the small one.
+        let [lo, hi] = quadratic_roots(1.0, -1e8, 1.0);
+        assert!((lo.unwrap() - 1e-8).abs() < 1e-22);
+        assert!((hi.unwrap() - 1e8).abs() < 1e-6);
+        assert_eq!(quadratic_roots(1.0, 0.0, 1.0), [None, None]);
+        assert_eq!(quadratic_roots(0.0, 2.0, -4.0), [Some(2.0), None]);
+    }
+}
