@@ -16,7 +16,7 @@ use crate::circle::{CircleState, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
 use crate::components::Sleep;
 use crate::config::{
-    CirclesConfig, DropConfig, Effects, MAX_CIRCLES, SoftConfig, Solver, SpawnConfig,
+    CirclesConfig, DropConfig, Effects, MAX_CIRCLES, MassModel, SoftConfig, Solver, SpawnConfig,
 };
 use crate::error::InputError;
 use crate::exact::EngineState;
@@ -31,7 +31,7 @@ use crate::soft::{CacheSnapshot, SoftState};
 use crate::spawn::{Dropped, SpawnReport};
 
 /// The first field of every checkpoint: what it is and the layout's version.
-const FORMAT: &str = "moving_circles checkpoint 4";
+const FORMAT: &str = "moving_circles checkpoint 5";
 /// Most bytes a checkpoint may have: the most circles an input may ask for, each with its
 /// engine state, fit.
 pub const MAX_CHECKPOINT_BYTES: u64 = 2 << 30;
@@ -49,6 +49,8 @@ pub struct Checkpoint {
     dt: f64,
     segments: Segments,
     drop: Option<DropConfig>,
+    /// The spawn rules' mass model, which gives dropped circles their mass.
+    mass: MassModel,
     dropped: usize,
     requested: usize,
     circles: Vec<CircleState>,
@@ -87,6 +89,7 @@ impl Checkpoint {
             dt: world.resource::<Time<Fixed>>().timestep().as_secs_f64(),
             segments: world.resource::<Segments>().clone(),
             drop: world.get_resource::<DropConfig>().copied(),
+            mass: world.resource::<SpawnConfig>().mass,
             dropped: world.resource::<Dropped>().count,
             requested: world.resource::<SpawnReport>().requested,
             circles: snapshot(world),
@@ -184,7 +187,11 @@ impl Checkpoint {
         for (i, c) in self.circles.iter().enumerate() {
             check_vector("position", c.position)
                 .and_then(|()| check_vector("velocity", c.velocity))
-                .and_then(|()| check_mass("mass", c.mass))
+                // Immovable circles (static pegs, kinematic paddles) have an infinite mass.
+                .and_then(|()| match c.mass {
+                    f64::INFINITY => Ok(()),
+                    m => check_mass("mass", m),
+                })
                 .map_err(|e| e.within(&format!("circles[{i}]")))
                 .map_err(describe)?;
             if !(c.radius > 0.0 && 2.0 * c.radius <= self.arena.size().min_element()) {
@@ -232,6 +239,7 @@ impl Checkpoint {
             arena: self.arena,
             spawn: SpawnConfig {
                 count: 0,
+                mass: self.mass,
                 ..SpawnConfig::default()
             },
             solver: self.solver,

@@ -98,6 +98,23 @@ fn spawn_rules_are_checked_before_anything_is_allocated() {
 }
 
 #[test]
+fn drop_rules_are_checked_against_the_mass_model_and_the_least_radius() {
+    // Below the least radius (1e-9 of the arena's side), and a mass from the drops' own radius
+    // (3e-32), not the spawn rules' (3e-30, in range).
+    assert_starts(
+        &scene_error("(drop: (count: 1, radius: 1e-17, position: (0.0, 0.0)))"),
+        "bad.ron: field `drop.radius`: must be at least 1e-9",
+    );
+    assert_starts(
+        &scene_error(
+            "(arena: (size: (1e-3, 1e-3)), spawn: (count: 0, radius: (1e-5, 1e-5)), \
+             mass: Area(density: 1e-20), drop: (count: 1, radius: 1e-6, position: (0.0, 0.0)))",
+        ),
+        "bad.ron: field `drop.radius`: the spawn rules' mass model gives a drop a mass that must be between",
+    );
+}
+
+#[test]
 fn explicit_circles_are_checked_one_by_one() {
     let circle = |fields: &str| {
         scene_error(&format!(

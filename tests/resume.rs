@@ -54,12 +54,15 @@ fn a_resumed_run_ends_bit_for_bit_where_the_whole_run_ends_under_every_solver() 
     let (whole_txt, whole_json, c1) = (p("whole.txt"), p("whole.json"), p("c1"));
     // A walled rack of billiards and a periodic gas: the engine's events cross the pause; and a
     // heap under gravity, whose resting contacts `soft` warm starts across it and whose circles
-    // come to rest and sleep across it under every solver that holds a heap.
+    // come to rest and sleep across it under every solver that holds a heap; and the Galton
+    // board: static pegs, segment walls, and balls of a given mass dropped on either side of
+    // each pause.
     let every = ["discrete", "substeps=4", "soft", "swept", "exact"];
     let runs = [
         ("assets/scenes/billiards.ron", &every[..]),
         ("assets/scenes/gas1k.ron", &every[..]),
         ("assets/scenes/gravity.ron", &["soft", "swept", "exact"][..]),
+        ("assets/scenes/galton.ron", &every[..]),
     ];
     for (scene, solvers) in runs {
         for &solver in solvers {

@@ -7,9 +7,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::arena::Arena;
 use crate::error::FieldError;
-use crate::range::{check_magnitude, check_vector};
+use crate::range::{check_magnitude, check_mass, check_vector};
 
-use super::MAX_CIRCLES;
+use super::spawn::{MIN_RADIUS_FRACTION, min_radius};
+use super::{MAX_CIRCLES, MassModel};
 
 /// Drops `count` circles of `radius`, one every `every` simulated seconds, at `position` moved
 /// sideways by up to `spread` (seeded), with `velocity`. A drop waits while the spot is taken.
@@ -48,10 +49,11 @@ impl Default for DropConfig {
 }
 
 impl DropConfig {
-    /// Whether the drops fit `arena`: a positive interval, a radius that fits, every drop
-    /// point inside with walls to spare, at most [`MAX_CIRCLES`]. Fields are named relative to
+    /// Whether the drops fit `arena`: a positive interval, a radius that fits (and is not below
+    /// the least radius a circle there may have), a mass from `mass` (the spawn rules' model)
+    /// within range, every drop point inside with walls to spare, at most [`MAX_CIRCLES`]. Fields are named relative to
     /// the drop rules (`every`, `radius`, …).
-    pub fn check(&self, arena: &Arena) -> Result<(), FieldError> {
+    pub fn check(&self, arena: &Arena, mass: MassModel) -> Result<(), FieldError> {
         if self.count > MAX_CIRCLES {
             let why = format!(
                 "asks for {} circles; at most {MAX_CIRCLES} are supported",
@@ -68,6 +70,22 @@ impl DropConfig {
             let why = format!("must be positive and fit the arena, got {}", self.radius);
             return Err(FieldError::new("radius", why));
         }
+        if self.radius < min_radius(arena) {
+            let why = format!(
+                "must be at least {MIN_RADIUS_FRACTION:?} of the arena's smaller side ({:?}), \
+                 got {:?}",
+                min_radius(arena),
+                self.radius
+            );
+            return Err(FieldError::new("radius", why));
+        }
+        check_mass("mass", mass.mass_of(self.radius)).map_err(|e| {
+            let why = format!(
+                "the spawn rules' mass model gives a drop a mass that {}",
+                e.message
+            );
+            FieldError::new("radius", why)
+        })?;
         check_vector("position", self.position)?;
         check_vector("velocity", self.velocity)?;
         if !(self.spread.is_finite() && self.spread >= 0.0) {

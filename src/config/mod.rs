@@ -207,7 +207,8 @@ impl CirclesConfig {
         self.spawn.mass.check()?;
         self.segments.check(&self.arena)?;
         if let Some(drop) = &self.drop {
-            drop.check(&self.arena).map_err(|e| e.within("drop"))?;
+            drop.check(&self.arena, self.spawn.mass)
+                .map_err(|e| e.within("drop"))?;
         }
         self.spawn.check(&self.arena).map_err(|e| e.within("spawn"))
     }
