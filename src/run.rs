@@ -243,6 +243,10 @@ pub struct Report {
     pub max_penetration: f64,
     /// Mean overlap of the overlapping pairs seen after (sampled) steps, same units.
     pub mean_penetration: f64,
+    /// Deepest overlap in the final state (at rest, for a pile that settled), same units.
+    pub final_penetration: f64,
+    /// Kinetic energy at the end (what a pile that should have settled has left).
+    pub kinetic_final: f64,
     /// Centres outside the arena at the end.
     pub escaped: usize,
     /// Circles with a non-finite position or velocity at the end.
@@ -279,6 +283,8 @@ impl Report {
             self.momentum_final[1],
             self.max_penetration,
             self.mean_penetration,
+            self.final_penetration,
+            self.kinetic_final,
             self.z.unwrap_or(0.0),
             self.z_wall.unwrap_or(0.0),
         ];
@@ -297,6 +303,7 @@ impl Report {
         let pairs = *world.resource::<PairCollisions>();
         let walls = *world.resource::<WallCollisions>();
         let arena = *world.resource::<Arena>();
+        let final_overlaps = Overlaps::measure(&discs(&snapshot(world)), &arena);
         let sleeping = world
             .query::<&Sleep>()
             .iter(world)
@@ -339,6 +346,8 @@ impl Report {
             momentum_final: after.momentum.to_array(),
             max_penetration: overlaps.max,
             mean_penetration: overlaps.mean(),
+            final_penetration: final_overlaps.max,
+            kinetic_final: after.kinetic_energy,
             escaped: after.escaped,
             non_finite: after.non_finite,
             pair_collisions: pairs.count,

@@ -78,11 +78,12 @@ fn every_ball_lands_in_a_bin_clear_of_the_pegs_in_a_bell_shape() {
 }
 
 #[test]
-fn a_few_balls_land_exactly_under_the_continuous_solvers() {
-    // With few balls the bins hold no tall piles (a resting pile under gravity with
-    // restitution below 1 is inelastic collapse for an event-driven solver; see the README).
+fn balls_land_exactly_under_the_continuous_solvers() {
+    // The bins fill with small piles that must come to rest without a ball sinking into another
+    // or the budget running out (inelastic collapse, held off by the contact time and sleeping:
+    // docs/piles.md); 40 balls keep the test quick at the test build's optimisation.
     for solver in ["swept", "exact"] {
-        let (bins, deepest) = run_board(solver, 15, 10.0);
+        let (bins, deepest) = run_board(solver, 40, 15.0);
         eprintln!("{solver}: deepest into a peg {deepest:.3e} radii, bins {bins:?}");
         assert!(
             deepest <= 1e-9,

@@ -1,5 +1,5 @@
 //! The hard-case suite: every file in `tests/hard/` under every solver, each checked against
-//! the invariants that solver promises (the table in the README):
+//! the invariants that solver promises (docs/testing.md, "Hard cases"):
 //!
 //! | invariant | exact | swept | substeps=4 | discrete |
 //! |---|---|---|---|---|

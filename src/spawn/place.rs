@@ -126,7 +126,7 @@ pub fn place_circles(
     }
     // Spawn in row-major cell order, so circles near each other in space are near each other in
     // memory: the collision pass then walks its arrays mostly in order (at 1M circles this is the
-    // difference between cache hits and misses; see the README's performance section).
+    // difference between cache hits and misses; see docs/performance.md).
     random.sort_by_cached_key(|c| {
         let (x, y) = grid.cell_of(c.position);
         (y, x)

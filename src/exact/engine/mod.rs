@@ -253,7 +253,7 @@ impl EventEngine {
     }
 
     /// Gives each circle its own restitution (one value per circle, in order; empty: all take
-    /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`].
+    /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`](crate::collide::contact::combine_restitution).
     pub fn set_own_restitutions(&mut self, restitutions: Vec<f64>) {
         assert!(restitutions.is_empty() || restitutions.len() == self.len());
         self.own_restitution = restitutions;
