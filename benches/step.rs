@@ -1,8 +1,8 @@
 //! Whole-App benchmarks: one `app.update()` (exactly one fixed step) of a headless app, after
 //! `finish()`, spawning and one warm-up step. Per solver on gases of growing N, and the price of
 //! effects: a no-collision scene against the same scene with collisions and against bare
-//! integration; collision messages off and on; a gas without and among 2000 segment walls; and
-//! a sparse step, where the step's own work is all there is.
+//! integration; collision messages off and on; a gas without and among 2000 segment walls; a
+//! sparse step, where the step's own work is all there is; and the pile scenes once they rest.
 //!
 //! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver and
 //! N = 1M for `discrete`.
@@ -172,6 +172,57 @@ fn sparse_step(c: &mut Criterion) {
     bench_config(c, "step_sparse", BenchmarkId::new("exact", n), n, config);
 }
 
+/// What a pile costs once it rests: each pile scene under each solver, run until it has come to
+/// rest (asleep, under `soft`, `swept` and `exact`; a heap that never rests, under the course's
+/// solvers), then one step timed. `soft` is the scene's own setting (the Galton board's
+/// `soft=8`). The run to rest happens the first time a benchmark is selected, so a filter that
+/// leaves these out does not pay for it. What a pile costs while it forms is a run report's
+/// `ms_per_step` (docs/piles.md).
+fn piles(c: &mut Criterion) {
+    let scenes = [
+        ("column", 5.0),
+        ("pyramid", 5.0),
+        ("galton", 45.0),
+        ("pile", 20.0),
+    ];
+    let solvers = [
+        Solver::Soft(4),
+        Solver::Substeps(4),
+        Solver::Discrete,
+        Solver::Swept,
+        Solver::Exact,
+    ];
+    let mut group = c.benchmark_group("step_pile");
+    group.sample_size(20);
+    for (name, seconds) in scenes {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("assets/scenes")
+            .join(format!("{name}.ron"));
+        let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let n = scene.circles.len() + scene.spawn.count + scene.drop.map_or(0, |d| d.count);
+        group.throughput(Throughput::Elements(n as u64));
+        for solver in solvers {
+            let mut config = scene.clone();
+            if !matches!((solver, config.solver), (Solver::Soft(_), Solver::Soft(_))) {
+                config.solver = solver;
+            }
+            let id = BenchmarkId::new(config.solver.to_string(), name);
+            let mut app = None;
+            group.bench_function(id, |b| {
+                let app = app.get_or_insert_with(|| {
+                    let mut app = headless_app(config.clone());
+                    for _ in 0..(seconds * 60.0) as u32 {
+                        app.update();
+                    }
+                    app
+                });
+                b.iter(|| app.update())
+            });
+        }
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     solvers,
@@ -179,6 +230,7 @@ criterion_group!(
     hit_messages,
     segments,
     eos_point,
-    sparse_step
+    sparse_step,
+    piles
 );
 criterion_main!(benches);

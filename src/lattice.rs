@@ -12,17 +12,6 @@ use bevy::math::DVec2;
 ///
 /// Returns every site, row by row (at least `n`), or, when even the best shape puts two sites
 /// closer than `2r`, the largest radius it could take.
-///
-/// ```
-/// use bevy::math::DVec2;
-/// use moving_circles::lattice::lattice_sites;
-///
-/// let sites = lattice_sites(DVec2::ZERO, DVec2::ONE, true, 100, 0.04).unwrap();
-/// assert!(sites.len() >= 100);
-/// // Too big for 100 in a unit square: the error says how big they may be.
-/// let largest = lattice_sites(DVec2::ZERO, DVec2::ONE, true, 100, 0.06).unwrap_err();
-/// assert!(largest > 0.04 && largest < 0.06);
-/// ```
 pub fn lattice_sites(
     origin: DVec2,
     size: DVec2,
@@ -143,6 +132,14 @@ fn best_shape(size: DVec2, periodic: bool, n: usize) -> (usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn circles_too_big_for_the_rectangle_are_told_how_big_they_may_be() {
+        let sites = lattice_sites(DVec2::ZERO, DVec2::ONE, true, 100, 0.04).unwrap();
+        assert!(sites.len() >= 100);
+        let largest = lattice_sites(DVec2::ZERO, DVec2::ONE, true, 100, 0.06).unwrap_err();
+        assert!(largest > 0.04 && largest < 0.06);
+    }
 
     /// The closest distance between any two sites (through the seam when periodic).
     fn closest_pair(sites: &[DVec2], size: DVec2, periodic: bool) -> f64 {

@@ -118,10 +118,7 @@
 //! The plain data the kernels work on:
 //! - [`arena`]: the region the circles live in, walls or periodic;
 //! - [`circle`]: one circle's state outside the ECS;
-//! - [`grid`]: the uniform grid every part that buckets circles shares;
-//! - [`lattice`]: triangular lattices fitted to a rectangle, for dense states;
 //! - [`segment`]: segment walls and the cells they pass near;
-//! - [`range`]: the one physical range of every input value;
 //! - [`error`]: the errors of bad input.
 //!
 //! Files, runs and studies:
@@ -131,8 +128,11 @@
 //! - [`checkpoint`]: a run's whole state, to resume bit for bit;
 //! - [`commands`]: the work behind each `moving_circles` command;
 //! - [`accuracy`]: the accuracy study of every solver against `exact`;
-//! - [`eos`]: the hard-disk equation of state;
-//! - [`figure`]: what the studies' figures share.
+//! - [`eos`]: the hard-disk equation of state.
+//!
+//! Internal to the crate (see `docs/architecture.md`): the uniform grid every part that buckets
+//! circles shares, triangular lattices for dense states, the one physical range of every input
+//! value (its limits are re-exported by [`config`]) and what the studies' figures share.
 //!
 //! # The guide
 //!
@@ -167,14 +167,14 @@ pub mod effects;
 pub mod eos;
 pub mod error;
 pub mod exact;
-pub mod figure;
+mod figure;
 pub mod forces;
-pub mod grid;
+mod grid;
 pub mod hits;
 pub mod integrate;
 pub mod io;
-pub mod lattice;
-pub mod range;
+mod lattice;
+mod range;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod run;

@@ -156,7 +156,7 @@ pub fn check_end(field: &str, p: DVec2, arena: &Arena) -> Result<(), FieldError>
     Ok(())
 }
 
-/// For each cell of a [`Grid`], the segments that pass within `margin` of it (and possibly a
+/// For each cell of a `Grid`, the segments that pass within `margin` of it (and possibly a
 /// few more: a cell takes a segment when it is within `margin` plus half the cell's diagonal
 /// of the cell's centre). A circle of radius at most `margin` whose centre is in a cell can
 /// only touch the segments of that cell; one larger than a cell looks at the cells its bounding

@@ -1,4 +1,4 @@
-//! The study's figure ([`AccuracyFigure`], written as SVG and PNG through [`crate::figure`]): a row
+//! The study's figure ([`AccuracyFigure`], as SVG and PNG): a row
 //! of panels per scene, one panel per error measure ([`MEASURES`]), each plotting error
 //! against cost (ms per simulated second) on log axes. A line joins one solver's runs at 30, 60 and 120 Hz
 //! (marker shape gives the rate), the `exact` reference is a dashed vertical line at its cost

@@ -1,5 +1,5 @@
-//! The equation-of-state figure ([`EosFigure`], written as SVG and PNG through
-//! [`crate::figure`]): on the left `Z` against area fraction, measured points with their block
+//! The equation-of-state figure ([`EosFigure`], as SVG and PNG): on the left `Z` against area
+//! fraction, measured points with their block
 //! error bars over Henderson's and Liu's curves (Liu solid where it is meant, to 0.65, dashed
 //! beyond) and the large-N literature value at 0.70; on the right each point's deviation from
 //! Liu in per cent, with the ±0.5 % band.

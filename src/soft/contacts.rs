@@ -34,7 +34,7 @@ pub enum Partner {
 pub struct Constraint {
     /// The first circle.
     pub a: u32,
-    /// The second circle, or [`NONE`] for a wall.
+    /// The second circle, or `NONE` (`u32::MAX`) for a wall.
     pub b: u32,
     /// What the other side is, for matching across steps and for messages.
     pub partner: Partner,

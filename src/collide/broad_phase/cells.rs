@@ -1,4 +1,4 @@
-//! The broad phase's cell list: circles binned into the cells of a [`Grid`] by one counting
+//! The broad phase's cell list: circles binned into the cells of a `Grid` by one counting
 //! sort per step (parallel for large N), so the circles of each cell sit side by side in
 //! [`CellList::order`].
 

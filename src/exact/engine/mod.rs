@@ -10,7 +10,7 @@
 //! Positions are advanced lazily: circle `i` is at `pos + vel·(t - t_at)` (plus `½g(t - t_at)²`
 //! if it falls), its reference point
 //! moved only where its course changes, and every event time is worked out from reference
-//! points, so the run does not depend on the cells. A [`Grid`] of cells sized to the density
+//! points, so the run does not depend on the cells. A `Grid` of cells sized to the density
 //! (`walls::cell_width`) and at least one diameter of every circle in them wide, with
 //! memberships kept up to date by cell-crossing events, keeps prediction local; a few circles far
 //! wider than that stay out of the cells (`large`). A crossing changes no trajectory, so it
