@@ -64,17 +64,22 @@ pub fn exit_time(x: f64, v: f64, acc: f64, lo: f64, hi: f64) -> Option<(f64, boo
 /// velocity `dv` with relative acceleration `da` (one falls, the other does not), first come
 /// within `sigma` of each other while approaching: the first `τ ≥ 0` where
 /// `|dp + dv·τ + ½da·τ²| = σ` and the distance shrinks. Touching or overlapping by rounding
-/// and approaching (or pushed together) now: `Some(0)`.
+/// and approaching (or pushed together) now: `Some(0)`. A caller that only wants a time sooner
+/// than `horizon` (one it already has) may get `None` for a later one: a pair too far apart to
+/// meet by then is ruled out before any root is looked for.
 ///
 /// ```
 /// use bevy::math::DVec2;
 /// use moving_circles::exact::fall::falling_pair_time;
 ///
 /// // A ball 2 above a peg, radii summing to 1, dropped at rest under g = 2: it falls 1 in 1.
-/// let t = falling_pair_time(DVec2::new(0.0, -2.0), DVec2::ZERO, DVec2::new(0.0, 2.0), 1.0);
+/// let (dp, dv, da) = (DVec2::new(0.0, -2.0), DVec2::ZERO, DVec2::new(0.0, 2.0));
+/// let t = falling_pair_time(dp, dv, da, 1.0, f64::INFINITY);
 /// assert!((t.unwrap() - 1.0).abs() < 1e-12);
+/// // Not sooner than 0.5: ruled out.
+/// assert_eq!(falling_pair_time(dp, dv, da, 1.0, 0.5), None);
 /// ```
-pub fn falling_pair_time(dp: DVec2, dv: DVec2, da: DVec2, sigma: f64) -> Option<f64> {
+pub fn falling_pair_time(dp: DVec2, dv: DVec2, da: DVec2, sigma: f64, horizon: f64) -> Option<f64> {
     let a = 0.5 * da;
     // f(τ) = |a τ² + dv τ + dp|² − σ², highest power last.
     let c = [
@@ -90,7 +95,17 @@ pub fn falling_pair_time(dp: DVec2, dv: DVec2, da: DVec2, sigma: f64) -> Option<
     if c[0] <= 0.0 && (c[1] < 0.0 || (c[1] == 0.0 && c[2] < 0.0)) {
         return Some(0.0);
     }
-    first_entering_root(&c)
+    // The gap closes no faster than the relative speed and acceleration allow (with a margin
+    // far above the rounding of the distance and the reach, so that no time sooner than the
+    // horizon is ever ruled out).
+    if horizon.is_finite() {
+        let distance = dp.length();
+        let reach = dv.length() * horizon + a.length() * horizon * horizon;
+        if distance - sigma - reach > 1e-9 * (distance + sigma + reach) {
+            return None;
+        }
+    }
+    first_entering_root(&c, horizon)
 }
 
 /// When a circle of radius `r` at `p` moving at `v` with acceleration `acc` first touches
@@ -105,7 +120,7 @@ pub fn falling_segment_time(
 ) -> Option<f64> {
     let ends = [segment.a, segment.b]
         .into_iter()
-        .filter_map(|end| falling_pair_time(end - p, -v, -acc, r));
+        .filter_map(|end| falling_pair_time(end - p, -v, -acc, r, f64::INFINITY));
     let face = falling_face_time(p, v, acc, r, segment);
     face.into_iter().chain(ends).reduce(f64::min)
 }
@@ -165,7 +180,7 @@ mod tests {
             DVec2::new(1.0, 0.0),
             DVec2::new(0.0, -2.0),
         );
-        let t = falling_pair_time(-p, -v, -g, 1.0).unwrap();
+        let t = falling_pair_time(-p, -v, -g, 1.0, f64::INFINITY).unwrap();
         let at = p + v * t + 0.5 * g * t * t;
         assert!((at.length() - 1.0).abs() < 1e-12, "at {at}, t = {t}");
         // Before that it was clear of the peg all along.
@@ -184,6 +199,7 @@ mod tests {
             DVec2::ZERO,
             DVec2::new(0.0, 2.0),
             1.0,
+            f64::INFINITY,
         );
         assert_eq!(t, None);
         // Thrown up past the peg's side and falling back beside it: the second pass is the
@@ -193,6 +209,7 @@ mod tests {
             DVec2::new(0.0, 3.0),
             DVec2::new(0.0, -2.0),
             1.0,
+            f64::INFINITY,
         );
         assert_eq!(t, None);
     }
@@ -206,7 +223,7 @@ mod tests {
             DVec2::new(0.0, -1e-9),
             DVec2::new(0.0, 2.0),
         );
-        let t = falling_pair_time(dp, dv, da, 1.0).expect("the hit is found");
+        let t = falling_pair_time(dp, dv, da, 1.0, f64::INFINITY).expect("the hit is found");
         assert!((t - 5e-10).abs() < 1e-15, "{t}");
         // The same against a floor: a centre below its bound by rounding, moving up slowly.
         let (t, high) = exit_time(-1e-16, 1e-9, -2.0, 0.0, 1.0).unwrap();
@@ -220,6 +237,7 @@ mod tests {
             DVec2::ZERO,
             DVec2::new(0.0, 2.0),
             1.0,
+            f64::INFINITY,
         );
         assert_eq!(t, Some(0.0));
         // Overlapping by rounding but moving away fast enough to beat gravity for a while: the
@@ -229,6 +247,7 @@ mod tests {
             DVec2::new(0.0, -4.0),
             DVec2::new(0.0, 2.0),
             1.0,
+            f64::INFINITY,
         )
         .unwrap();
         assert!((t - 4.0).abs() < 1e-9, "{t}");
@@ -255,7 +274,8 @@ mod tests {
     }
 
     /// The first contact found against the first sign change of dense sampling, on random
-    /// throws at a peg (positions, velocities and gravity of either sign).
+    /// throws at a peg (positions, velocities and gravity of either sign), with and without a
+    /// horizon.
     #[test]
     fn the_first_contact_matches_dense_sampling() {
         use rand::{Rng, SeedableRng};
@@ -270,7 +290,7 @@ mod tests {
             }
             let dv = DVec2::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
             let da = DVec2::new(rng.random_range(-1.0..1.0), rng.random_range(-10.0..10.0));
-            let found = falling_pair_time(dp, dv, da, 1.0);
+            let found = falling_pair_time(dp, dv, da, 1.0, f64::INFINITY);
             let gap = |t: f64| (dp + dv * t + 0.5 * da * t * t).length() - 1.0;
             let step = horizon / samples as f64;
             let sampled = (1..=samples)
@@ -280,6 +300,14 @@ mod tests {
                 (Some(t), Some(s)) => assert!(t <= s && t > s - step - 1e-12, "{dp} {dv} {da}"),
                 (Some(t), None) => assert!(t > horizon - step, "{dp} {dv} {da}: {t}"),
                 (None, s) => assert_eq!(s, None, "{dp} {dv} {da}: missed"),
+            }
+            // A horizon rules out only later times, and changes no time it finds.
+            for h in [0.1, 0.5, 2.0] {
+                match (found, falling_pair_time(dp, dv, da, 1.0, h)) {
+                    (Some(t), Some(u)) => assert_eq!(t, u, "{dp} {dv} {da}"),
+                    (Some(t), None) => assert!(t >= h, "{dp} {dv} {da}: {t} ruled out by {h}"),
+                    (None, u) => assert_eq!(u, None, "{dp} {dv} {da}"),
+                }
             }
             checked += 1;
         }

@@ -1,7 +1,8 @@
 //! Real roots of the small polynomials times of impact lead to, as plain functions:
 //! [`quadratic_roots`] in the forms that do not cancel, and [`first_entering_root`], the first
 //! time a quartic (a distance squared against a reach squared) falls to zero, found by
-//! splitting the line at its turning points and refining by safeguarded Newton steps.
+//! splitting the line at its turning points and refining by safeguarded Newton steps. Nothing
+//! here allocates: they run for every pair of a falling and a resting circle.
 
 /// The real roots of `a·τ² + b·τ + c`, smaller first (`None` for a missing one), taken in the
 /// forms that do not cancel.
@@ -27,14 +28,18 @@ pub fn quadratic_roots(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
 /// most 4, positive leading coefficient) goes from positive to zero, or starts to fall while at
 /// or below zero: the turning points (roots of its derivative) split `[0, ∞)` into pieces where
 /// it is monotonic, and the first piece that falls from above zero to zero or below holds the
-/// root, or the first that falls from zero or below starts at it.
-pub fn first_entering_root(c: &[f64; 5]) -> Option<f64> {
+/// root, or the first that falls from zero or below starts at it. Pieces that begin at or after
+/// `horizon` are not looked at (`None`, as if there were no root), so a caller that only wants a
+/// root sooner than one it has stops early; a root that is found does not depend on `horizon`.
+pub fn first_entering_root(c: &[f64; 5], horizon: f64) -> Option<f64> {
     let f = |t: f64| horner(c, t);
     let derivative = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4]];
-    let mut turns = cubic_roots_after_zero(&derivative);
-    turns.push(f64::INFINITY);
+    let (turns, count) = cubic_roots_after_zero(&derivative);
     let mut from = 0.0;
-    for to in turns {
+    for &to in turns[..count].iter().chain(&[f64::INFINITY]) {
+        if from >= horizon {
+            return None;
+        }
         let end = if to.is_finite() { to } else { far_end(c, from) };
         let (f_from, f_to) = (f(from), f(end));
         if f_from > 0.0 && f_to <= 0.0 {
@@ -72,15 +77,23 @@ fn horner(c: &[f64], t: f64) -> f64 {
     c.iter().rev().fold(0.0, |acc, &k| acc * t + k)
 }
 
-/// The real roots `τ > 0` of the cubic `d` (constant first), in increasing order: its own
-/// turning points (a quadratic's roots) split the line into monotonic pieces, each bisected.
-fn cubic_roots_after_zero(d: &[f64; 4]) -> Vec<f64> {
+/// The real roots `τ > 0` of the cubic `d` (constant first), in increasing order, and how many
+/// there are: its own turning points (a quadratic's roots) split the line into monotonic
+/// pieces, each solved by safeguarded Newton steps.
+fn cubic_roots_after_zero(d: &[f64; 4]) -> ([f64; 3], usize) {
     let g = |t: f64| horner(d, t);
-    let mut cuts: Vec<f64> = quadratic_roots(3.0 * d[3], 2.0 * d[2], d[1])
+    let mut cuts = [0.0; 3];
+    let mut n = 0;
+    for t in quadratic_roots(3.0 * d[3], 2.0 * d[2], d[1])
         .into_iter()
         .flatten()
-        .filter(|&t| t > 0.0 && t.is_finite())
-        .collect();
+    {
+        if t > 0.0 && t.is_finite() {
+            cuts[n] = t;
+            n += 1;
+        }
+    }
+    let mut roots = [0.0; 3];
     let bound = if d[3] != 0.0 {
         1.0 + [d[0], d[1], d[2]]
             .iter()
@@ -94,39 +107,51 @@ fn cubic_roots_after_zero(d: &[f64; 4]) -> Vec<f64> {
     } else if d[1] != 0.0 {
         1.0 + (d[0] / d[1]).abs()
     } else {
-        return Vec::new();
+        return (roots, 0);
     };
-    cuts.push(bound);
-    let mut roots = Vec::new();
+    cuts[n] = bound;
+    let mut count = 0;
     let mut from = 0.0;
-    for to in cuts {
-        if to <= from {
+    for &to in &cuts[..=n] {
+        // A piece holds at most one root, and there are at most three pieces.
+        if to <= from || count == 3 {
             continue;
         }
         let (a, b) = (g(from), g(to));
         if a == 0.0 && from > 0.0 {
-            roots.push(from);
+            roots[count] = from;
+            count += 1;
         } else if (a < 0.0) != (b < 0.0) && b != 0.0 {
-            roots.push(bisect(|t| horner(d, t), from, to));
+            roots[count] = monotonic_root(d, from, to);
+            count += 1;
         }
         from = to;
     }
-    roots
+    (roots, count)
 }
 
-/// A root of `f` in `[a, b]`, where `f(a)` and `f(b)` differ in sign, by bisection to the last
-/// bit.
-fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
-    let below = f(a) < 0.0;
+/// A root of the cubic `d` in `[a, b]`, where it is monotonic and its values at the ends differ
+/// in sign: Newton steps kept inside a shrinking bracket (bisection whenever a step would leave
+/// it), to the last bit.
+fn monotonic_root(d: &[f64; 4], mut a: f64, mut b: f64) -> f64 {
+    let slope = [d[1], 2.0 * d[2], 3.0 * d[3]];
+    let below = horner(d, a) < 0.0;
+    let mut t = 0.5 * (a + b);
     for _ in 0..200 {
-        let m = 0.5 * (a + b);
-        if m <= a || m >= b {
-            break;
-        }
-        if (f(m) < 0.0) == below {
-            a = m;
+        let gt = horner(d, t);
+        if (gt < 0.0) == below {
+            a = t;
         } else {
-            b = m;
+            b = t;
+        }
+        let newton = t - gt / horner(&slope, t);
+        t = if newton > a && newton < b && newton.is_finite() {
+            newton
+        } else {
+            0.5 * (a + b)
+        };
+        if t <= a || t >= b {
+            break;
         }
     }
     a

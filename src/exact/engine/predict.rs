@@ -86,7 +86,10 @@ impl EventEngine {
         let impact = if da == DVec2::ZERO {
             pair_time_of_impact(dp, dv, sum)
         } else {
-            falling_pair_time(dp, dv, da, sum)
+            // Only a time sooner than the best so far can be kept; the horizon is padded by what
+            // rounding `since + t` may take, so it rules out no time the comparison below keeps.
+            let pad = 4.0 * f64::EPSILON * best.time.abs().max(since.abs());
+            falling_pair_time(dp, dv, da, sum, best.time - since + pad)
         };
         if let Some(t) = impact
             && (since + t).max(now) < best.time
