@@ -30,12 +30,13 @@ enum Command {
     /// Run a scene or particle file headless and report (no window).
     Run(Box<RunArgs>),
     /// Run the accuracy study: every solver and step on a set of scenes, measured against
-    /// `exact`; prints a table and writes accuracy.csv and the figure (accuracy.svg and .png).
+    /// `exact`; prints a table and writes accuracy.csv and the figure (accuracy.svg and .png);
+    /// then the pile scenes, measured on their own terms, into piles.csv.
     Accuracy {
-        /// Folder for accuracy.csv, accuracy.svg and accuracy.png.
+        /// Folder for accuracy.csv, accuracy.svg, accuracy.png and piles.csv.
         #[arg(long, value_name = "DIR", default_value = "out")]
         out: PathBuf,
-        /// Folder the study's scenes (gas1k, gas, billiards, fast) are read from.
+        /// Folder the study's scenes (gas1k, gas, billiards, fast; galton, pile) are read from.
         #[arg(long, value_name = "DIR", default_value = "assets/scenes")]
         scenes: PathBuf,
         /// One step size and shorter runs: a smoke test of the study, not a measurement.

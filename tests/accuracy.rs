@@ -1,5 +1,6 @@
 //! The accuracy study and `--solver auto`: the study writes its CSV (every solver present) and
-//! its figure as SVG and PNG (every scene and measure); tunnelling is told apart from bouncing; `auto` picks cheap solvers for loose
+//! its figure as SVG and PNG (every scene and measure), and its pile scenes' CSV (what holds a
+//! stack and what does not); tunnelling is told apart from bouncing; `auto` picks cheap solvers for loose
 //! tolerances and an exact one for tight tolerances.
 
 use std::process::Command;
@@ -114,5 +115,47 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
         count([255, 255, 255]) > pixels.len() / 6,
         "mostly not background"
     );
+    // The pile part: every pile solver on the pyramid, measured on its own terms. The
+    // event-driven solvers hold it at rounding and it settles at once; `soft` within a
+    // fiftieth, settled and asleep; the course's one contact pass lets it sink and never rest.
+    let piles = std::fs::read_to_string(out.join("piles.csv")).unwrap();
+    let header: Vec<&str> = piles.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = piles
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let row = |solver: &str| {
+        rows.iter()
+            .find(|r| r[column("scene")] == "pyramid" && r[column("solver")] == solver)
+            .unwrap_or_else(|| panic!("pyramid/{solver} missing:\n{piles}"))
+    };
+    let number = |r: &Vec<&str>, name: &str| r[column(name)].parse::<f64>().unwrap();
+    for solver in ["swept", "exact", "soft", "soft=8"] {
+        let r = row(solver);
+        let bound = if solver.starts_with("soft") {
+            0.02
+        } else {
+            1e-9
+        };
+        assert!(number(r, "rest_penetration") <= bound, "{solver}: {r:?}");
+        assert!(
+            !r[column("settled_at")].is_empty(),
+            "{solver} never settled"
+        );
+        assert_eq!(r[column("asleep")], "210", "{solver}");
+    }
+    for solver in ["discrete", "substeps=4"] {
+        let r = row(solver);
+        assert!(
+            number(r, "rest_penetration") > 0.1,
+            "{solver} held the stack: {r:?}"
+        );
+        assert!(
+            r[column("settled_at")].is_empty(),
+            "{solver} settled: {r:?}"
+        );
+    }
     std::fs::remove_dir_all(&out).unwrap();
 }

@@ -6,11 +6,14 @@
 //! - [`report`]: the rows as CSV and as a table;
 //! - [`front`]: the error measures the figure shows and the Pareto front of each;
 //! - [`plot`]: the figure, as SVG and PNG;
+//! - [`piles`]: the pile scenes, measured on their own terms (overlap at rest, energy left,
+//!   time to settle, cost) and the cheapest setting per overlap budget;
 //! - [`auto`]: `--solver auto`, the cheapest solver within a tolerance on the user's scene.
 
 pub mod auto;
 pub mod front;
 pub mod measure;
+pub mod piles;
 pub mod plot;
 pub mod report;
 
@@ -55,6 +58,38 @@ pub fn default_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputE
                 horizon,
             })
         })
+        .collect()
+}
+
+/// The study's pile scenes (the Galton board for 45 s, the 2000-circle pile for 20 s), from the
+/// scene files in `scenes_dir`; when `quick`, the pyramid for 2 s.
+pub fn pile_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputError> {
+    let plan: &[(&str, f64)] = if quick {
+        &[("pyramid", 2.0)]
+    } else {
+        &[("galton", 45.0), ("pile", 20.0)]
+    };
+    plan.iter()
+        .map(|&(name, seconds)| {
+            Ok(Case {
+                name: name.to_owned(),
+                config: Scene::load(&scenes_dir.join(format!("{name}.ron")))?,
+                seconds,
+                horizon: seconds,
+            })
+        })
+        .collect()
+}
+
+/// The solvers and steps every pile case is run with: 60 Hz alone when `quick`.
+pub fn pile_settings(quick: bool) -> Vec<(Solver, f64)> {
+    let dts: &[f64] = if quick {
+        &[1.0 / 60.0]
+    } else {
+        &[1.0 / 30.0, 1.0 / 60.0, 1.0 / 120.0]
+    };
+    dts.iter()
+        .flat_map(|&dt| piles::PILE_SOLVERS.iter().map(move |&s| (s, dt)))
         .collect()
 }
 

@@ -1,15 +1,17 @@
 //! `moving_circles accuracy`: run the accuracy study with a progress bar, print its table and
-//! write `accuracy.csv` with the figure as `accuracy.svg` and `accuracy.png`.
+//! write `accuracy.csv` with the figure as `accuracy.svg` and `accuracy.png`; then the pile
+//! scenes, their table and picks printed and written to `piles.csv`.
 
 use std::path::Path;
 
 use anyhow::Context;
 
 use super::write_results;
+use crate::accuracy::piles::{pile_study, pile_table};
 use crate::accuracy::plot::AccuracyFigure;
 use crate::accuracy::report::{to_fronts, to_table};
-use crate::accuracy::{default_cases, settings, study};
-use crate::io::say;
+use crate::accuracy::{default_cases, pile_cases, pile_settings, settings, study};
+use crate::io::{csv_text, say, write_atomically};
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
 /// writes its CSV and plot into `out`.
@@ -33,5 +35,30 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     bar.finish_and_clear();
     to_table(&rows).lines().for_each(say);
     to_fronts(&rows).lines().for_each(say);
-    write_results(&rows, &AccuracyFigure(&rows), out, "accuracy")
+    write_results(&rows, &AccuracyFigure(&rows), out, "accuracy")?;
+    piles(out, scenes, quick)
+}
+
+/// The pile part of the study: runs it with a progress bar, prints its table and picks, and
+/// writes `piles.csv` into `out`.
+fn piles(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
+    let (cases, settings) = (pile_cases(scenes, quick)?, pile_settings(quick));
+    let bar = indicatif::ProgressBar::new((cases.len() * settings.len()) as u64).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} pile runs  {msg}")
+            .expect("valid template"),
+    );
+    let mut runs_done = 0;
+    let rows = pile_study(&cases, &settings, |case, (solver, dt)| {
+        bar.set_position(runs_done);
+        runs_done += 1;
+        bar.set_message(format!("{}: {solver} at {:.0} Hz", case.name, 1.0 / dt));
+    });
+    bar.finish_and_clear();
+    pile_table(&rows).lines().for_each(say);
+    let csv = out.join("piles.csv");
+    let text = csv_text(&rows).context("formatting the CSV")?;
+    write_atomically(&csv, text.as_bytes())
+        .with_context(|| format!("writing {}", csv.display()))?;
+    say(format_args!("wrote {}", csv.display()));
+    Ok(())
 }
