@@ -79,7 +79,7 @@ fn horner(c: &[f64], t: f64) -> f64 {
 
 /// The real roots `τ > 0` of the cubic `d` (constant first), in increasing order, and how many
 /// there are: its own turning points (a quadratic's roots) split the line into monotonic
-/// pieces, each solved by safeguarded Newton steps.
+/// pieces, each solved by safeguarded Newton steps from the closed form's estimate.
 fn cubic_roots_after_zero(d: &[f64; 4]) -> ([f64; 3], usize) {
     let g = |t: f64| horner(d, t);
     let mut cuts = [0.0; 3];
@@ -110,6 +110,7 @@ fn cubic_roots_after_zero(d: &[f64; 4]) -> ([f64; 3], usize) {
         return (roots, 0);
     };
     cuts[n] = bound;
+    let estimates = cubic_estimates(d);
     let mut count = 0;
     let mut from = 0.0;
     for &to in &cuts[..=n] {
@@ -122,7 +123,14 @@ fn cubic_roots_after_zero(d: &[f64; 4]) -> ([f64; 3], usize) {
             roots[count] = from;
             count += 1;
         } else if (a < 0.0) != (b < 0.0) && b != 0.0 {
-            roots[count] = monotonic_root(d, from, to);
+            // Newton from the closed form's root in the piece, where there is one: a few
+            // steps to the last bit instead of tens from the middle.
+            let guess = estimates
+                .iter()
+                .copied()
+                .find(|&t| t > from && t < to)
+                .unwrap_or(0.5 * (from + to));
+            roots[count] = monotonic_root(d, from, to, guess);
             count += 1;
         }
         from = to;
@@ -130,13 +138,47 @@ fn cubic_roots_after_zero(d: &[f64; 4]) -> ([f64; 3], usize) {
     (roots, count)
 }
 
+/// The real roots of the cubic `d` (constant first) by the closed form (Cardano's, or the
+/// trigonometric one for three roots), as starting points only: rounding may put them off by
+/// far more than the last bit, and a missing one is `NaN`.
+fn cubic_estimates(d: &[f64; 4]) -> [f64; 3] {
+    if d[3] == 0.0 {
+        let [lo, hi] = quadratic_roots(d[2], d[1], d[0]);
+        return [lo.unwrap_or(f64::NAN), hi.unwrap_or(f64::NAN), f64::NAN];
+    }
+    let (a, b, c) = (d[2] / d[3], d[1] / d[3], d[0] / d[3]);
+    // t = x − a/3: x³ + p·x + q = 0.
+    let p = b - a * a / 3.0;
+    let q = 2.0 * a * a * a / 27.0 - a * b / 3.0 + c;
+    let shift = -a / 3.0;
+    let disc = 0.25 * q * q + p * p * p / 27.0;
+    if disc > 0.0 {
+        let s = disc.sqrt();
+        [
+            shift + (-0.5 * q + s).cbrt() + (-0.5 * q - s).cbrt(),
+            f64::NAN,
+            f64::NAN,
+        ]
+    } else if p < 0.0 {
+        let r = 2.0 * (-p / 3.0).sqrt();
+        let phi = ((3.0 * q / (2.0 * p)) * (-3.0 / p).sqrt())
+            .clamp(-1.0, 1.0)
+            .acos()
+            / 3.0;
+        let third = std::f64::consts::TAU / 3.0;
+        [0.0, 1.0, 2.0].map(|k| shift + r * (phi - third * k).cos())
+    } else {
+        [shift, f64::NAN, f64::NAN]
+    }
+}
+
 /// A root of the cubic `d` in `[a, b]`, where it is monotonic and its values at the ends differ
-/// in sign: Newton steps kept inside a shrinking bracket (bisection whenever a step would leave
-/// it), to the last bit.
-fn monotonic_root(d: &[f64; 4], mut a: f64, mut b: f64) -> f64 {
+/// in sign, from `guess` inside: Newton steps kept inside a shrinking bracket (bisection
+/// whenever a step would leave it), to the last bit.
+fn monotonic_root(d: &[f64; 4], mut a: f64, mut b: f64, guess: f64) -> f64 {
     let slope = [d[1], 2.0 * d[2], 3.0 * d[3]];
     let below = horner(d, a) < 0.0;
-    let mut t = 0.5 * (a + b);
+    let mut t = guess;
     for _ in 0..200 {
         let gt = horner(d, t);
         if (gt < 0.0) == below {
@@ -196,5 +238,26 @@ mod tests {
         assert!((hi.unwrap() - 1e8).abs() < 1e-6);
         assert_eq!(quadratic_roots(1.0, 0.0, 1.0), [None, None]);
         assert_eq!(quadratic_roots(0.0, 2.0, -4.0), [Some(2.0), None]);
+    }
+
+    #[test]
+    fn a_cubics_roots_are_found_from_the_closed_forms_estimates() {
+        // (τ − 1)(τ − 2)(τ − 3): three roots, estimated by the trigonometric form.
+        let three = [-6.0, 11.0, -6.0, 1.0];
+        let mut estimates = cubic_estimates(&three);
+        estimates.sort_by(f64::total_cmp);
+        for (e, root) in estimates.iter().zip([1.0, 2.0, 3.0]) {
+            assert!((e - root).abs() < 1e-12, "{estimates:?}");
+        }
+        let (roots, count) = cubic_roots_after_zero(&three);
+        assert_eq!(count, 3);
+        for (r, root) in roots.iter().zip([1.0, 2.0, 3.0]) {
+            assert!((r - root).abs() < 1e-14, "{roots:?}");
+        }
+        // τ³ − 8: one real root, by Cardano's form.
+        let one = [-8.0, 0.0, 0.0, 1.0];
+        assert!((cubic_estimates(&one)[0] - 2.0).abs() < 1e-12);
+        assert_eq!(cubic_roots_after_zero(&one).1, 1);
+        assert!((cubic_roots_after_zero(&one).0[0] - 2.0).abs() < 1e-15);
     }
 }
