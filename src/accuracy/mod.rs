@@ -29,13 +29,18 @@ use crate::scene::Scene;
 
 /// The solvers and steps every case is run with: one step size when `quick`.
 pub fn settings(quick: bool) -> Vec<(Solver, f64)> {
+    each_solver_and_step(&SOLVERS, quick)
+}
+
+/// Every one of `solvers` at 30, 60 and 120 Hz, or at 60 Hz alone when `quick`.
+fn each_solver_and_step(solvers: &[Solver], quick: bool) -> Vec<(Solver, f64)> {
     let dts: &[f64] = if quick {
         &[1.0 / 60.0]
     } else {
         &[1.0 / 30.0, 1.0 / 60.0, 1.0 / 120.0]
     };
     dts.iter()
-        .flat_map(|&dt| SOLVERS.iter().map(move |&s| (s, dt)))
+        .flat_map(|&dt| solvers.iter().map(move |&s| (s, dt)))
         .collect()
 }
 
@@ -83,14 +88,7 @@ pub fn pile_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputErro
 
 /// The solvers and steps every pile case is run with: 60 Hz alone when `quick`.
 pub fn pile_settings(quick: bool) -> Vec<(Solver, f64)> {
-    let dts: &[f64] = if quick {
-        &[1.0 / 60.0]
-    } else {
-        &[1.0 / 30.0, 1.0 / 60.0, 1.0 / 120.0]
-    };
-    dts.iter()
-        .flat_map(|&dt| piles::PILE_SOLVERS.iter().map(move |&s| (s, dt)))
-        .collect()
+    each_solver_and_step(&piles::PILE_SOLVERS, quick)
 }
 
 /// Runs every case under every setting and compares each run with the case's `exact`

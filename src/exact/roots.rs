@@ -175,18 +175,33 @@ fn cubic_estimates(d: &[f64; 4]) -> [f64; 3] {
 /// A root of the cubic `d` in `[a, b]`, where it is monotonic and its values at the ends differ
 /// in sign, from `guess` inside: Newton steps kept inside a shrinking bracket (bisection
 /// whenever a step would leave it), to the last bit.
-fn monotonic_root(d: &[f64; 4], mut a: f64, mut b: f64, guess: f64) -> f64 {
+fn monotonic_root(d: &[f64; 4], a: f64, b: f64, guess: f64) -> f64 {
     let slope = [d[1], 2.0 * d[2], 3.0 * d[3]];
     let below = horner(d, a) < 0.0;
-    let mut t = guess;
-    for _ in 0..200 {
-        let gt = horner(d, t);
-        if (gt < 0.0) == below {
+    let value = |t: f64| (horner(d, t), horner(&slope, t));
+    bracketed_newton(value, |g| (g < 0.0) == below, (a, b), guess, 200).0
+}
+
+/// Newton steps on `value` (its value and slope at a point) from `start`, kept inside the
+/// bracket `(a, b)` as it shrinks (bisection whenever a step would leave it), for at most
+/// `steps` steps or until a step lands on an end: a point moves the end `a` when `on_a_side`
+/// says its value is on `a`'s side of zero, else the end `b`. Returns the final bracket.
+fn bracketed_newton(
+    value: impl Fn(f64) -> (f64, f64),
+    on_a_side: impl Fn(f64) -> bool,
+    (mut a, mut b): (f64, f64),
+    start: f64,
+    steps: u32,
+) -> (f64, f64) {
+    let mut t = start;
+    for _ in 0..steps {
+        let (ft, slope) = value(t);
+        if on_a_side(ft) {
             a = t;
         } else {
             b = t;
         }
-        let newton = t - gt / horner(&slope, t);
+        let newton = t - ft / slope;
         t = if newton > a && newton < b && newton.is_finite() {
             newton
         } else {
@@ -196,34 +211,17 @@ fn monotonic_root(d: &[f64; 4], mut a: f64, mut b: f64, guess: f64) -> f64 {
             break;
         }
     }
-    a
+    (a, b)
 }
 
 /// The first `τ` in `[a, b]` where the polynomial `c`, positive at `a` and not at `b` and
 /// monotonic between, reaches zero: Newton steps, kept inside a shrinking bracket (bisection
 /// whenever a step would leave it), to the last bit. Returns the bracket's upper end, where
 /// the polynomial is zero or below: the contact is then reached, never missed by rounding.
-fn refine(c: &[f64; 5], mut a: f64, mut b: f64) -> f64 {
+fn refine(c: &[f64; 5], a: f64, b: f64) -> f64 {
     let d = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4]];
-    let mut t = b;
-    for _ in 0..100 {
-        let (ft, dt) = (horner(c, t), horner(&d, t));
-        if ft > 0.0 {
-            a = t;
-        } else {
-            b = t;
-        }
-        let newton = t - ft / dt;
-        t = if newton > a && newton < b && newton.is_finite() {
-            newton
-        } else {
-            0.5 * (a + b)
-        };
-        if t <= a || t >= b {
-            break;
-        }
-    }
-    b
+    let value = |t: f64| (horner(c, t), horner(&d, t));
+    bracketed_newton(value, |f| f > 0.0, (a, b), b, 100).1
 }
 
 #[cfg(test)]
