@@ -138,31 +138,40 @@ impl ContactCache {
 
     /// Keeps the impulses `constraints` ended the step with, for the next step's
     /// [`ContactCache::warm_start`].
-    pub fn store<'a>(&mut self, ids: &[u64], constraints: impl Iterator<Item = &'a Constraint>) {
-        let mut by_circle: Vec<(u32, Cached)> = constraints
-            .map(|c| {
-                let entry = Cached {
-                    partner: c.partner,
-                    impulse: c.impulse,
-                    touching: c.total_impulse > 0.0,
-                };
-                (c.a, entry)
-            })
-            .collect();
-        by_circle.sort_by_key(|&(a, _)| a);
+    pub fn store<'a>(
+        &mut self,
+        ids: &[u64],
+        constraints: impl Iterator<Item = &'a Constraint> + Clone,
+    ) {
         self.ids.clear();
         self.ids.extend_from_slice(ids);
         self.index_of.clear();
+        // A counting sort by circle, each circle's contacts in the order given.
         self.start.clear();
         self.start.resize(ids.len() + 1, 0);
-        for &(a, _) in &by_circle {
-            self.start[a as usize + 1] += 1;
+        for c in constraints.clone() {
+            self.start[c.a as usize + 1] += 1;
         }
         for i in 0..ids.len() {
             self.start[i + 1] += self.start[i];
         }
+        let mut next = self.start.clone();
+        let empty = Cached {
+            partner: Partner::Wall(Wall::Segment(0)),
+            impulse: 0.0,
+            touching: false,
+        };
         self.entries.clear();
-        self.entries.extend(by_circle.into_iter().map(|(_, e)| e));
+        self.entries.resize(self.start[ids.len()] as usize, empty);
+        for c in constraints {
+            let slot = &mut next[c.a as usize];
+            self.entries[*slot as usize] = Cached {
+                partner: c.partner,
+                impulse: c.impulse,
+                touching: c.total_impulse > 0.0,
+            };
+            *slot += 1;
+        }
     }
 }
 
