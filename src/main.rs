@@ -10,8 +10,8 @@ use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
 use moving_circles::arena::Boundary;
 use moving_circles::commands;
-use moving_circles::commands::run::MAX_THREADS;
 use moving_circles::commands::run::{Input, Length, RunOptions, SolverChoice};
+use moving_circles::commands::run::{MAX_STEPS, MAX_THREADS};
 use moving_circles::config::{DT_RANGE, Placement, Solver};
 use moving_circles::io::printable;
 
@@ -91,7 +91,8 @@ struct AppArgs {
     /// Seed of the random placement (overrides the scene).
     #[arg(long)]
     seed: Option<u64>,
-    /// Solver: `discrete`, `substeps=N`, `swept` or `exact` (overrides the scene).
+    /// Solver: `discrete`, `substeps=N`, `soft`, `soft=N`, `swept` or `exact` (overrides the
+    /// scene).
     #[arg(long)]
     solver: Option<Solver>,
     /// Render `--frames` frames, save the window to this PNG and exit.
@@ -115,8 +116,9 @@ struct RunArgs {
     /// Particle file: `N`, then `rx ry vx vy radius mass r g b` per line, in the unit square.
     #[arg(long, value_name = "PATH")]
     particles: Option<PathBuf>,
-    /// Solver: `discrete`, `substeps=N`, `swept`, `exact`, or `auto` (the cheapest that meets
-    /// `--tolerance`, from a short calibration run). Default: the scene's, or `discrete`.
+    /// Solver: `discrete`, `substeps=N`, `soft`, `soft=N`, `swept`, `exact`, or `auto` (the
+    /// cheapest that meets `--tolerance`, from a short calibration run). Default: the scene's,
+    /// or `discrete`.
     #[arg(long)]
     solver: Option<SolverChoice>,
     /// With `--solver auto`: the largest acceptable error, as the larger of the position error
@@ -132,8 +134,8 @@ struct RunArgs {
     /// Simulated seconds to run (rounded up to whole steps).
     #[arg(long)]
     seconds: Option<f64>,
-    /// Fixed steps to run.
-    #[arg(long)]
+    /// Fixed steps to run (from 1 to 10^10).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_STEPS))]
     steps: Option<u64>,
     /// Seed of the random placement (overrides the scene).
     #[arg(long)]
@@ -160,8 +162,8 @@ struct RunArgs {
     /// when interrupted, and every `--every` steps.
     #[arg(long, value_name = "PATH")]
     checkpoint: Option<PathBuf>,
-    /// Steps between checkpoints, counted from the start of the run.
-    #[arg(long, value_name = "N", requires = "checkpoint")]
+    /// Steps between checkpoints (at least 1), counted from the start of the run.
+    #[arg(long, value_name = "N", requires = "checkpoint", value_parser = clap::value_parser!(u64).range(1..))]
     every: Option<u64>,
     /// Go on from a checkpoint, with its settings, for `--steps` / `--seconds` more; the result
     /// is bit for bit that of the run without the pause.

@@ -161,7 +161,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             let (config, source) = configure(input, &options)?;
             let dt = config.dt;
             set_threads(options.threads);
-            let mut app = start(config)?;
+            let mut app = start(config, &source)?;
             let progress = Progress::start(app.world_mut());
             (app, progress, source, dt)
         }
@@ -319,19 +319,26 @@ fn set_threads(threads: Option<u16>) {
     }
 }
 
-/// The headless app of `config`, its circles placed (saying so first when that takes a while,
-/// and afterwards when not all fit).
-fn start(config: CirclesConfig) -> anyhow::Result<App> {
+/// The headless app of `config` from `source`, its circles placed (saying so first when that
+/// takes a while, and afterwards when not all fit).
+fn start(config: CirclesConfig, source: &str) -> anyhow::Result<App> {
     let placing = config.spawn.target_count(&config.arena);
-    if config.spawn.placement == Placement::Pack && placing >= ANNOUNCE_PACK_FROM {
-        eprintln!("moving_circles: compressing {placing} circles (this takes a while)");
-    } else if placing >= ANNOUNCE_SPAWN_FROM {
-        eprintln!("moving_circles: placing {placing} circles at random (this takes a while)");
+    let how = match config.spawn.placement {
+        Placement::Pack => "compressing",
+        Placement::Lattice => "placing on a lattice",
+        Placement::Random => "placing at random",
+    };
+    let announce_from = match config.spawn.placement {
+        Placement::Pack => ANNOUNCE_PACK_FROM,
+        _ => ANNOUNCE_SPAWN_FROM,
+    };
+    if placing >= announce_from {
+        eprintln!("moving_circles: {how} {placing} circles (this takes a while)");
     }
     let app = headless_app(config);
     let spawn = app.world().resource::<SpawnReport>();
     if let Some(refused) = &spawn.refused {
-        bail!("cannot spawn the scene's circles: {refused}");
+        bail!("{source}: cannot spawn the scene's circles: {refused}");
     }
     if spawn.placed < spawn.requested {
         eprintln!(

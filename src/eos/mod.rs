@@ -20,7 +20,9 @@ use serde::Serialize;
 use crate::arena::{Arena, Boundary};
 use crate::circle::snapshot;
 use crate::collide::PairCollisions;
-use crate::config::{CirclesConfig, DT_RANGE, Effects, MassModel, Placement, Solver, SpawnConfig};
+use crate::config::{
+    CirclesConfig, DT_RANGE, Effects, MAX_CIRCLES, MassModel, Placement, Solver, SpawnConfig,
+};
 use crate::diagnostics::{CircleDiagnostics, Pressure};
 use crate::error::FieldError;
 use crate::run::headless_app;
@@ -71,10 +73,10 @@ impl Default for EosOptions {
 impl EosOptions {
     /// Whether these can be measured; the field is named as on the command line.
     pub fn check(&self) -> Result<(), FieldError> {
-        if self.n < 2 {
+        if !(2..=MAX_CIRCLES).contains(&self.n) {
             return Err(FieldError::new(
                 "n",
-                format!("needs at least 2 disks, got {}", self.n),
+                format!("needs 2 to {MAX_CIRCLES} disks, got {}", self.n),
             ));
         }
         if self.area_fractions.is_empty() {

@@ -221,9 +221,13 @@ struct PlacementGrid {
 impl PlacementGrid {
     fn new(arena: &Arena, r_max: f64, count: usize) -> Self {
         let size = arena.size();
-        // Never more cells than about one per circle: a tiny radius in a big arena must not
-        // allocate millions of empty cells.
-        let cell = (2.0 * r_max).max((size.x * size.y / count.max(1) as f64).sqrt());
+        // Never more cells than about three per circle: a tiny radius in a big arena must not
+        // allocate millions of empty cells, nor a long thin one a row of billions (hence the
+        // longer side over the count as well as the area over it).
+        let per = count.max(1) as f64;
+        let cell = (2.0 * r_max)
+            .max((size.x * size.y / per).sqrt())
+            .max(size.max_element() / per);
         let cols = ((size.x / cell).ceil() as usize).max(1);
         let rows = ((size.y / cell).ceil() as usize).max(1);
         let grid = Grid::square(arena.min, cell, cols, rows);
@@ -258,6 +262,25 @@ impl PlacementGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_placement_grid_has_at_most_three_cells_per_circle_whatever_the_arena() {
+        for (size, r_max, count) in [
+            (DVec2::new(1e18, 9.0), 0.1, 32),
+            (DVec2::new(9.0, 1e18), 0.1, 32),
+            (DVec2::new(1e17, 1e17), 1e-6, 1000),
+            (DVec2::new(16.0, 9.0), 0.1, 0),
+            (DVec2::new(1e-9, 1e-9), 1e-12, 5_000_000),
+        ] {
+            let arena = Arena::centered(size);
+            let grid = PlacementGrid::new(&arena, r_max, count).grid;
+            assert!(
+                grid.len() <= 3 * count.max(1) + 1,
+                "{size} with {count} circles: {} cells",
+                grid.len()
+            );
+        }
+    }
 
     #[test]
     fn a_full_arena_places_what_fits_and_stops() {
