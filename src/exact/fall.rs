@@ -101,8 +101,25 @@ pub fn falling_pair_time(dp: DVec2, dv: DVec2, da: DVec2, sigma: f64, horizon: f
     if horizon.is_finite() {
         let distance = dp.length();
         let reach = dv.length() * horizon + a.length() * horizon * horizon;
-        if distance - sigma - reach > 1e-9 * (distance + sigma + reach) {
+        let margin = 1e-9 * (distance + sigma + reach);
+        if distance - sigma - reach > margin {
             return None;
+        }
+        // Tighter, along the line between them now: the distance is at least its part along
+        // `u`, `|dp| + (dv·u)·τ + (a·u)·τ²`, whose least value over `[0, horizon]` is at an
+        // end or where it turns. A pair side by side under gravity is ruled out here.
+        if distance > 0.0 {
+            let u = dp / distance;
+            let (w, alpha) = (dv.dot(u), a.dot(u));
+            let along = |t: f64| distance + w * t + alpha * t * t;
+            let turn = -w / (2.0 * alpha);
+            let mut least = along(0.0).min(along(horizon));
+            if turn > 0.0 && turn < horizon {
+                least = least.min(along(turn));
+            }
+            if least - sigma > margin {
+                return None;
+            }
         }
     }
     first_entering_root(&c, horizon)
