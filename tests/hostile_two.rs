@@ -120,3 +120,68 @@ fn an_equation_of_state_of_too_many_disks_blames_n() {
     assert!(!err.contains("spawn.radius"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_dump_of_static_circles_reads_back_as_the_same_circles() {
+    let dir = temp_dir("static");
+    let (first, second) = (dir.join("first.txt"), dir.join("second.txt"));
+    // Pegs in the unit square (the particle format's arena): the dump writes their mass `inf`.
+    let scene = dir.join("pegs.ron");
+    std::fs::write(
+        &scene,
+        "(arena: (size: (1.0, 1.0), center: (0.5, 0.5)), \
+          effects: (gravity: (0.0, -9.81), restitution: 0.5), \
+          spawn: (count: 20, radius: (0.02, 0.03)), \
+          circles: [(position: (0.3, 0.2), radius: 0.05, immovable: true), \
+                    (position: (0.7, 0.2), radius: 0.05, immovable: true)])",
+    )
+    .unwrap();
+    let out = under_one_gib(&[
+        "run",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--steps",
+        "30",
+        "--dump",
+        first.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&first).unwrap();
+    let statics = text.lines().filter(|l| l.contains(" inf ")).count();
+    assert_eq!(statics, 2, "the pegs in the dump:\n{text}");
+    // The dump is a particle file: it reads back, its static circles still static.
+    let out = under_one_gib(&[
+        "run",
+        "--particles",
+        first.to_str().unwrap(),
+        "--steps",
+        "1",
+        "--solver",
+        "exact",
+        "--dump",
+        second.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let again = std::fs::read_to_string(&second).unwrap();
+    let static_lines = |t: &str| -> Vec<String> {
+        t.lines()
+            .filter(|l| l.contains(" inf "))
+            .map(str::to_owned)
+            .collect()
+    };
+    assert_eq!(static_lines(&text), static_lines(&again), "the pegs moved");
+    // A moving static circle is still refused, naming its line.
+    let moving = dir.join("moving.txt");
+    std::fs::write(&moving, "1\n0.5 0.5 0.1 0 0.1 inf 0 0 0\n").unwrap();
+    let out = under_one_gib(&[
+        "run",
+        "--particles",
+        moving.to_str().unwrap(),
+        "--steps",
+        "1",
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("line 2") && err.contains("static"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

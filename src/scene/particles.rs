@@ -122,8 +122,11 @@ fn parse_circle(line: &str) -> Result<CircleState, String> {
         let value: f64 = words[k]
             .parse()
             .map_err(|_| format!("{} is not a number: `{}`", FIELDS[k], words[k]))?;
-        if !value.is_finite() {
-            return Err(format!("{} must be finite, got `{}`", FIELDS[k], words[k]));
+        // A mass of +∞ is a static circle (what a dump of immovable circles writes).
+        let immovable = k == 5 && value == f64::INFINITY;
+        if !value.is_finite() && !immovable {
+            let what = if k == 5 { "finite or `inf`" } else { "finite" };
+            return Err(format!("{} must be {what}, got `{}`", FIELDS[k], words[k]));
         }
         *slot = value;
     }
