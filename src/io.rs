@@ -101,7 +101,10 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let name = path.file_name().unwrap_or_default().to_string_lossy();
     let prefix = format!(".{name}.");
     let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".partial");
+    builder
+        .prefix(&prefix)
+        .suffix(TEMPORARY_SUFFIX)
+        .rand_bytes(TEMPORARY_RANDOM);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -116,9 +119,17 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     Ok(())
 }
 
-/// Whether `path` can take an output: its folder exists, and the path is free or a regular
-/// file. Directories, devices, pipes, sockets and symbolic links are refused, so that an output
-/// never replaces a device node or writes through a link somewhere else.
+/// The end of [`write_atomically`]'s temporary file's name.
+const TEMPORARY_SUFFIX: &str = ".partial";
+/// Random characters in that name.
+const TEMPORARY_RANDOM: usize = 6;
+/// The longest file name most file systems take, in bytes.
+pub const MAX_NAME_BYTES: usize = 255;
+
+/// Whether `path` can take an output: its folder exists, the path is free or a regular file,
+/// and its name is short enough that the temporary file beside it ([`write_atomically`]) can
+/// be made. Directories, devices, pipes, sockets and symbolic links are refused, so that an
+/// output never replaces a device node or writes through a link somewhere else.
 pub fn check_output_path(path: &Path) -> io::Result<()> {
     let refuse = |what: &str| {
         io::Error::new(
@@ -129,8 +140,22 @@ pub fn check_output_path(path: &Path) -> io::Result<()> {
             ),
         )
     };
-    if path.file_name().is_none() {
+    let Some(name) = path.file_name() else {
         return Err(refuse("not a file name"));
+    };
+    // `.NAME.` + random + suffix: what the temporary file's name adds.
+    let longest = MAX_NAME_BYTES - 2 - TEMPORARY_RANDOM - TEMPORARY_SUFFIX.len();
+    if name.len() > longest {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{}: the file name is {} bytes; outputs take at most {longest} (the temporary \
+                 file written first adds {})",
+                path.display(),
+                name.len(),
+                MAX_NAME_BYTES - longest
+            ),
+        ));
     }
     match std::fs::symlink_metadata(path) {
         Ok(meta) if meta.file_type().is_file() => {}

@@ -174,6 +174,8 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             .expect("valid template"),
     );
     let sampling = default_sampling(app.world().resource::<crate::spawn::SpawnReport>().placed);
+    // What could not be written; the other outputs are written all the same.
+    let mut failed: Vec<anyhow::Error> = Vec::new();
     let stopped = loop {
         let now = app.world().resource::<StepTotals>().steps;
         let next = match (&options.checkpoint, options.every) {
@@ -187,10 +189,16 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
         if stopped || next >= until {
             break stopped;
         }
-        if let Some(path) = &options.checkpoint {
-            write_checkpoint(&mut app, &source, &progress, path)?;
+        if let Some(path) = &options.checkpoint
+            && let Err(e) = write_checkpoint(&mut app, &source, &progress, path)
+        {
+            // A periodic checkpoint that cannot be written (a full disk) ends the run here,
+            // with the report and the dump of where it got to.
+            failed.push(e);
+            break true;
         }
     };
+    let checkpoint_failed = !failed.is_empty();
     bar.finish_and_clear();
 
     let mut ended = progress;
@@ -206,16 +214,31 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     }
     if let Some(path) = &options.report {
         let json = serde_json::to_string_pretty(&report).context("serialising the report")?;
-        write_atomically(path, (json + "\n").as_bytes())
-            .with_context(|| format!("writing the report to {}", path.display()))?;
+        if let Err(e) = write_atomically(path, (json + "\n").as_bytes()) {
+            failed.push(
+                anyhow::Error::new(e).context(format!("writing the report to {}", path.display())),
+            );
+        }
     }
     if let Some(path) = &options.dump {
         let state = snapshot(app.world_mut());
-        write_atomically(path, particles::format(&state).as_bytes())
-            .with_context(|| format!("writing the final state to {}", path.display()))?;
+        if let Err(e) = write_atomically(path, particles::format(&state).as_bytes()) {
+            failed.push(
+                anyhow::Error::new(e)
+                    .context(format!("writing the final state to {}", path.display())),
+            );
+        }
     }
-    if let Some(path) = &options.checkpoint {
-        write_checkpoint(&mut app, &source, &progress, path)?;
+    // Once failed, the checkpoint is not tried again: the run stopped where it failed.
+    if let Some(path) = &options.checkpoint
+        && !checkpoint_failed
+        && let Err(e) = write_checkpoint(&mut app, &source, &progress, path)
+    {
+        failed.push(e);
+    }
+    if !failed.is_empty() {
+        let all: Vec<String> = failed.iter().map(|e| format!("{e:#}")).collect();
+        bail!("{} (the other outputs were written)", all.join("; "));
     }
     Ok(match interrupts.raised() {
         Some(signal) if stopped => {
@@ -350,8 +373,8 @@ fn start(config: CirclesConfig, source: &str) -> anyhow::Result<App> {
 }
 
 /// Refuses, before any work, outputs that could not be written or would clobber something:
-/// paths that are not regular files (devices, directories, links), missing folders, and the
-/// report and the dump on one file.
+/// paths that are not regular files (devices, directories, links), missing folders, names too
+/// long for the temporary file, two outputs on one file, and an output on the run's input.
 fn check_outputs(options: &RunOptions) -> anyhow::Result<()> {
     let outputs = [
         ("--report", &options.report),
@@ -373,6 +396,25 @@ fn check_outputs(options: &RunOptions) -> anyhow::Result<()> {
                     a.display()
                 );
             }
+        }
+    }
+    // An output must not replace the run's own input; a checkpoint may replace the one it
+    // resumes (written whole, it is the same run further on).
+    let (input_flag, input) = match &options.input {
+        Input::Scene(path) => ("--scene", path),
+        Input::Particles(path, _) => ("--particles", path),
+        Input::Resume(path) => ("--resume", path),
+    };
+    for (flag, path) in outputs {
+        let resumed_again = flag == "--checkpoint" && input_flag == "--resume";
+        if let Some(path) = path
+            && !resumed_again
+            && same_output(path, input)
+        {
+            bail!(
+                "{flag} names the input of {input_flag}, {}: it would be replaced",
+                path.display()
+            );
         }
     }
     if options.every.is_some() && options.checkpoint.is_none() {
