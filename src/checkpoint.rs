@@ -197,6 +197,11 @@ impl Checkpoint {
             if !(c.radius > 0.0 && 2.0 * c.radius <= self.arena.size().min_element()) {
                 return Err(format!("circle {i} has an impossible radius {}", c.radius));
             }
+            // Every step ends with each centre inside (put back or wrapped): one outside means
+            // the circle or the arena was changed.
+            if !self.arena.contains(c.position) {
+                return Err(format!("circle {i} at {} is outside the arena", c.position));
+            }
         }
         let p = &self.progress;
         let numbers = [
@@ -294,5 +299,38 @@ impl Checkpoint {
                 .map_err(|message| InputError::whole(origin, message))?;
         }
         Ok((app, self.progress))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bevy::math::DVec2;
+
+    #[test]
+    fn a_checkpoint_whose_arena_no_longer_holds_its_circles_is_refused() {
+        let mut config = CirclesConfig::default();
+        config.spawn.count = 16;
+        config.solver = Solver::Exact;
+        let mut app = headless_app(config);
+        app.update();
+        let progress = Progress::start(app.world_mut());
+        let good = Checkpoint::take(app.world_mut(), "t", &progress);
+        assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+        // A bound moved within the range of values, past the circles on that side.
+        let mut moved = good.clone();
+        let leftmost = good
+            .circles
+            .iter()
+            .map(|c| c.position.x)
+            .fold(f64::MAX, f64::min);
+        moved.arena.min.x = leftmost + 1e-3;
+        let error = Checkpoint::from_bytes(&moved.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("outside the arena"), "{error}");
+        moved.arena.min = DVec2::splat(-1e20);
+        moved.arena.max = DVec2::splat(-1e19);
+        assert!(Checkpoint::from_bytes(&moved.to_bytes(), "c").is_err());
     }
 }

@@ -129,9 +129,23 @@ impl EventEngine {
                 Kind::Wall { axis } | Kind::Cell { axis, .. } => axis < 2,
                 Kind::Segment => (event.partner as usize) < segments.len(),
             };
+            // A pending event lies ahead, at a finite time: the clock only ever advances to the
+            // soonest one.
+            let pending_ok =
+                event.kind == Kind::Idle || (s.time[i].is_finite() && s.time[i] >= s.now);
+            // A circle in the cell lists sits in its cell, or across an edge by rounding.
+            let (x, y) = grid.cell_of(c.position);
+            let near = |listed: u32, at: usize, count: usize| {
+                let apart = (listed as usize).abs_diff(at);
+                apart <= 1 || (grid.periodic && apart + 1 >= count)
+            };
+            let placed_ok = large.contains(&(i as u32))
+                || (near(s.cell_x[i], x, grid.cols) && near(s.cell_y[i], y, grid.rows));
             let best = s.best_pair[i];
             if !fits
                 || !kind_ok
+                || !pending_ok
+                || !placed_ok
                 || s.time[i].is_nan()
                 || best.time.is_nan()
                 || !partner_ok(best.partner, i)
@@ -250,29 +264,50 @@ mod tests {
         engine.advance_to(0.5, u64::MAX).unwrap();
         let now = circles_now(&engine, &circles);
         let good = engine.snapshot();
-        let damages: [fn(&mut EngineSnapshot); 7] = [
-            |s| s.now = f64::NAN,
-            |s| s.time[3] = f64::NAN,
-            |s| s.cell_x[5] = 1_000,
-            |s| s.counter.pop().map(drop).unwrap_or(()),
-            |s| {
+        let pending = (0..64)
+            .find(|&i| good.event[i].kind == Kind::Pair)
+            .expect("a pending collision");
+        let damages: [fn(&mut EngineSnapshot, usize); 10] = [
+            |s, _| s.now = f64::NAN,
+            |s, _| s.time[3] = f64::NAN,
+            |s, _| s.cell_x[5] = 1_000,
+            |s, _| s.counter.pop().map(drop).unwrap_or(()),
+            |s, _| {
                 s.event[2] = Event {
                     kind: Kind::Pair,
                     partner: 2,
                     partner_count: 0,
                 }
             },
-            |s| s.event[4].kind = Kind::Wall { axis: 7 },
-            |s| s.cell_y[9] = (s.cell_y[9] + 1) % 8,
+            |s, _| s.event[4].kind = Kind::Wall { axis: 7 },
+            |s, _| s.cell_y[9] = (s.cell_y[9] + 1) % 8,
+            // A pending collision put off for ever, flipped into the past, or before now.
+            |s, i| s.time[i] = f64::INFINITY,
+            |s, i| s.time[i] = f64::NEG_INFINITY,
+            |s, i| s.time[i] = s.now - 1e-3,
         ];
         for (k, damage) in damages.into_iter().enumerate() {
             let mut bad = good.clone();
-            damage(&mut bad);
+            damage(&mut bad, pending);
             assert!(
                 EventEngine::restore(bad, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_err(),
                 "damage {k} was accepted"
             );
         }
+        // A circle listed, consistently, in a cell two away from where it is.
+        let mut moved = good.clone();
+        let cols = engine.grid.cols;
+        assert!(cols >= 5, "{cols} columns");
+        let from = moved.cell_y[pending] as usize * cols + moved.cell_x[pending] as usize;
+        moved.cells.remove(pending, from);
+        moved.cell_x[pending] = (moved.cell_x[pending] + 2) % cols as u32;
+        moved
+            .cells
+            .insert(pending, from - from % cols + moved.cell_x[pending] as usize);
+        assert!(
+            EventEngine::restore(moved, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_err(),
+            "a circle two cells from its own was accepted"
+        );
         assert!(EventEngine::restore(good, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_ok());
     }
 }
