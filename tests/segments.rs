@@ -284,6 +284,32 @@ fn a_circle_dropped_into_a_wedge_settles_in_it_touching_both_sides() {
 }
 
 #[test]
+fn a_circle_in_a_narrow_v_never_leaves_it() {
+    // A V of 12 degrees, its point at (0, -1): the circle sinks in until it touches both sides,
+    // where each side's push presses it into the other. The discrete solvers once pushed it out
+    // through one side.
+    let (a, b) = (DVec2::new(-0.3, 1.9), DVec2::new(0.0, -1.0));
+    let c = DVec2::new(0.3, 1.9);
+    let inside = |p: DVec2| (b - a).perp_dot(p - a) > 0.0 && (c - b).perp_dot(p - b) > 0.0;
+    for solver in SOLVERS {
+        let (mut app, ball) = one_circle(
+            solver,
+            (4.0, 4.0),
+            "[[(-0.3, 1.9), (0.0, -1.0), (0.3, 1.9)]]",
+            "gravity: (0.0, -9.81), wall_restitution: 0.3",
+            [0.0, 1.5, 0.0, 0.0, 0.15],
+        );
+        for k in 0..600 {
+            step(&mut app, 1);
+            let p = state(&app, ball).0;
+            assert!(inside(p), "{solver}: out of the V at {p} after {k} steps");
+        }
+        let p = state(&app, ball).0;
+        assert!(p.y > 0.3 && p.x.abs() < 0.01, "{solver}: ended at {p}");
+    }
+}
+
+#[test]
 fn a_gas_in_a_maze_of_segments_never_enters_a_wall_and_keeps_its_energy() {
     // 60 circles among 40 segments in a grid of short bars (listed in many cells each).
     let mut bars = Vec::new();

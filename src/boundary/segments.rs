@@ -57,6 +57,11 @@ pub struct SegmentBounce {
 /// `restitution` (the bounce is returned); if it overlaps but already moves away, it is only put
 /// back to touching. A centre exactly on the segment goes back the way it came.
 ///
+/// `from` is where the centre was before the boundary pass began: a centre that another
+/// segment's push carried across this segment's line (between its ends) is on the wrong side,
+/// and is put back on the side it came from rather than pushed on through (so a circle in a
+/// narrow V cannot be pushed out of it from one side to the other).
+///
 /// ```
 /// use bevy::math::DVec2;
 /// use moving_circles::boundary::segments::reflect_off_segment;
@@ -64,7 +69,8 @@ pub struct SegmentBounce {
 ///
 /// let floor = Segment::new(DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0));
 /// let (mut p, mut v) = (DVec2::new(0.0, 0.4), DVec2::new(1.0, -2.0));
-/// let bounce = reflect_off_segment(&mut p, &mut v, 0.5, &floor, 1.0).unwrap();
+/// let from = p;
+/// let bounce = reflect_off_segment(&mut p, &mut v, 0.5, &floor, 1.0, from).unwrap();
 /// assert_eq!(v, DVec2::new(1.0, 2.0)); // the seed's angle rule on a horizontal wall
 /// assert!((p.y - 0.6).abs() < 1e-12 && bounce.normal == DVec2::new(0.0, -1.0));
 /// ```
@@ -74,8 +80,20 @@ pub fn reflect_off_segment(
     radius: f64,
     segment: &Segment,
     restitution: f64,
+    from: DVec2,
 ) -> Option<SegmentBounce> {
-    let (point, out, distance) = segment.contact(*position, *velocity);
+    let (point, mut out, mut distance) = segment.contact(*position, *velocity);
+    let normal = segment.normal();
+    let between_ends = point != segment.a && point != segment.b;
+    let (before, now) = (
+        (from - segment.a).dot(normal),
+        (*position - segment.a).dot(normal),
+    );
+    if between_ends && before * now < 0.0 {
+        // Pushed across the line this pass: back towards where it was, by the whole depth.
+        out = normal * before.signum();
+        distance = -now.abs();
+    }
     if distance >= radius {
         return None;
     }
@@ -92,6 +110,9 @@ pub fn reflect_off_segment(
         normal_speed: -vn,
     })
 }
+
+/// Passes over the segments near a circle in one boundary pass.
+pub const SEGMENT_PASSES: usize = 4;
 
 /// Applies [`reflect_off_segment`] to every circle and each segment near it (with its own
 /// restitution combined with the walls', if it has one), counts the bounces as wall hits and,
@@ -129,10 +150,13 @@ fn bounce_off_segments(
             combine_restitution(own.0, effects.wall_restitution)
         });
         let (mut p, mut v) = (position.0, velocity.0);
-        for &k in near.iter() {
+        let from = p;
+        // Each push may press the circle into another segment (a narrow V): a few passes
+        // settle it, each bounce counted as a hit.
+        for &k in near.iter().cycle().take(SEGMENT_PASSES * near.len()) {
             let before = v;
             let Some(bounce) =
-                reflect_off_segment(&mut p, &mut v, radius.0, &segments.0[k as usize], e)
+                reflect_off_segment(&mut p, &mut v, radius.0, &segments.0[k as usize], e, from)
             else {
                 continue;
             };
@@ -187,7 +211,8 @@ mod tests {
     fn an_end_reflects_along_the_line_from_it_to_the_centre() {
         // Head on into the right end along the segment's line.
         let (mut p, mut v) = (DVec2::new(1.4, 0.0), DVec2::new(-2.0, 0.0));
-        let bounce = reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 1.0).unwrap();
+        let from = p;
+        let bounce = reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 1.0, from).unwrap();
         assert_eq!(v, DVec2::new(2.0, 0.0));
         assert!((p.x - 1.6).abs() < 1e-12, "{p}");
         assert_eq!((bounce.point, bounce.normal), (DVec2::X, -DVec2::X));
@@ -196,8 +221,9 @@ mod tests {
     #[test]
     fn a_circle_moving_away_is_only_put_back() {
         let (mut p, mut v) = (DVec2::new(0.0, -0.3), DVec2::new(0.0, -1.0));
+        let from = p;
         assert_eq!(
-            reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 1.0),
+            reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 1.0, from),
             None
         );
         assert_eq!((p, v), (DVec2::new(0.0, -0.5), DVec2::new(0.0, -1.0)));
@@ -206,7 +232,8 @@ mod tests {
     #[test]
     fn a_centre_on_the_segment_goes_back_the_way_it_came() {
         let (mut p, mut v) = (DVec2::ZERO, DVec2::new(0.0, 3.0));
-        reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 0.5).unwrap();
+        let from = p;
+        reflect_off_segment(&mut p, &mut v, 0.5, &floor(), 0.5, from).unwrap();
         assert_eq!(v, DVec2::new(0.0, -1.5));
         assert_eq!(p, DVec2::new(0.0, -1.0));
     }
