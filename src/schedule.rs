@@ -98,6 +98,20 @@ impl StepTotals {
     }
 }
 
+/// A request from outside the app (the command line's signal handler) to end the current step
+/// as soon as it can: the event engine, which can spend seconds in one step, then ends it as
+/// when its event budget runs out (everything drifts to the step's end, counted in
+/// `budget_exhausted`). Absent, or never set, nothing changes.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct StopRequest(pub std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+impl StopRequest {
+    /// Whether a stop was asked for.
+    pub fn raised(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
 /// The core plugin: inserts the arena, segment walls, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
 /// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
 #[derive(Clone, Debug)]

@@ -229,6 +229,46 @@ fn a_signal_ends_the_run_after_a_step_with_everything_written() {
 }
 
 #[test]
+fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
+    let dir = temp_dir("long-step");
+    let report = dir.join("r.json");
+    // One step of 60 s of the 10 000-circle gas: seconds of events.
+    let mut child = command(&[
+        "run",
+        "--scene",
+        "assets/scenes/gas.ron",
+        "--solver",
+        "exact",
+        "--dt",
+        "60",
+        "--steps",
+        "3",
+        "--report",
+        report.to_str().unwrap(),
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, "TERM");
+    let sent = Instant::now();
+    let status = child.wait().unwrap();
+    let took = sent.elapsed();
+    assert_eq!(status.code(), Some(143));
+    let report: serde_json::Value = serde_json::from_str(&text(&report)).unwrap();
+    assert_eq!(report["interrupted"], true);
+    // The step was ended by drifting to its end, as when the event budget runs out.
+    assert_eq!(report["steps"].as_u64(), Some(1), "{report}");
+    assert_eq!(report["budget_exhausted"].as_u64(), Some(1), "{report}");
+    assert!(
+        took < Duration::from_secs(2),
+        "the run took {took:?} to stop"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
     let dir = temp_dir("twice");
     let report = dir.join("r.json");

@@ -32,7 +32,7 @@ use crate::collide::PairCollisions;
 use crate::components::{Mass, Position, Radius, Restitution, Sleep, SolverCircles, Velocity};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
-use crate::schedule::{CircleSystems, ContinuousStep, StepDt};
+use crate::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
 use crate::segment::Segments;
 use crate::sleep::Sleeping;
 use engine::{EngineSnapshot, EventEngine, EventStats, Rest};
@@ -175,6 +175,7 @@ struct StepSetup<'w> {
     effects: Res<'w, Effects>,
     segments: Res<'w, Segments>,
     dt: Res<'w, StepDt>,
+    stop: Option<Res<'w, StopRequest>>,
 }
 
 /// The `swept` / `exact` step: gathers the circles into the engine, advances it by the step and
@@ -194,6 +195,7 @@ fn continuous_step(
         effects,
         segments,
         dt,
+        stop,
     } = setup;
     let restitution_lost = !lost_restitution.is_empty();
     lost_restitution.clear();
@@ -205,8 +207,7 @@ fn continuous_step(
         &mut circles,
     );
     advance_engine(
-        *solver,
-        dt.0,
+        (*solver, dt.0, stop.as_deref()),
         &mut state,
         (&mut counted.pairs, &mut counted.walls),
         messages,
@@ -361,8 +362,7 @@ fn moved_since(
 /// Processes the step's events (within the solver's budget), counts what they did and, when
 /// recording, writes their hits as messages.
 fn advance_engine(
-    solver: Solver,
-    dt: f64,
+    (solver, dt, stop): (Solver, f64, Option<&StopRequest>),
     state: &mut EngineState,
     counted: (&mut PairCollisions, &mut WallCollisions),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
@@ -377,7 +377,8 @@ fn advance_engine(
     let budget = per_circle * (engine.len() as u64 + 1);
     let t_start = engine.now();
     let t_end = t_start + dt;
-    if engine.advance_to(t_end, budget).is_err() {
+    let stop = || stop.is_some_and(StopRequest::raised);
+    if engine.advance_until_stopped(t_end, budget, stop).is_err() {
         engine.drift_to(t_end);
         state.budget_exhausted += 1;
     }

@@ -45,6 +45,10 @@ use crate::grid::{CellMembers, Grid, NONE};
 use crate::hits::HitLog;
 use crate::segment::{Segment, SegmentCells};
 
+/// Events between two looks at [`EventEngine::advance_until_stopped`]'s stop request: about a
+/// millisecond of events, so a stop is seen at once and asking costs nothing.
+pub const STOP_POLL_EVENTS: u64 = 4096;
+
 /// An event-driven simulation of circles.
 ///
 /// ```
@@ -358,6 +362,17 @@ impl EventEngine {
     /// Processes every event up to time `t_end` and moves the clock there. Stops early (with the
     /// clock at the last processed event) after `max_events` events.
     pub fn advance_to(&mut self, t_end: f64, max_events: u64) -> Result<u64, BudgetExhausted> {
+        self.advance_until_stopped(t_end, max_events, || false)
+    }
+
+    /// [`EventEngine::advance_to`], also stopping early (as if the budget ran out) when `stop`
+    /// says so; it is asked every [`STOP_POLL_EVENTS`] events.
+    pub fn advance_until_stopped(
+        &mut self,
+        t_end: f64,
+        max_events: u64,
+        stop: impl Fn() -> bool,
+    ) -> Result<u64, BudgetExhausted> {
         let mut processed = 0;
         while let Some((i, time)) = self.queue.first() {
             if time > t_end {
@@ -372,7 +387,9 @@ impl EventEngine {
                 self.predict(i);
                 continue;
             }
-            if processed == max_events {
+            if processed == max_events
+                || (processed % STOP_POLL_EVENTS == STOP_POLL_EVENTS - 1 && stop())
+            {
                 return Err(BudgetExhausted { events: processed });
             }
             processed += 1;

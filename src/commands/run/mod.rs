@@ -1,0 +1,213 @@
+//! `moving_circles run`: load a scene or particle file (or resume a checkpoint), apply the
+//! command line's overrides (solver, or `auto` within a tolerance; step; seed; length), step it
+//! headless with a progress bar on a terminal, print a summary and write the report, the final
+//! state and checkpoints. SIGINT and SIGTERM end it after the current step with all of those
+//! written (a long event-driven step ends at once, through [`StopRequest`]); a second signal
+//! ends it at once.
+
+mod options;
+mod setup;
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use anyhow::{Context, bail};
+use bevy::prelude::App;
+
+use crate::checkpoint::Checkpoint;
+use crate::circle::snapshot;
+use crate::io::{say, write_atomically};
+use crate::run::{Progress, Report, advance, default_sampling, sample_end};
+use crate::scene::particles;
+use crate::schedule::{StepTotals, StopRequest};
+pub use options::{Finished, Input, Length, MAX_STEPS, MAX_THREADS, RunOptions, SolverChoice};
+use setup::{check_outputs, configure, set_threads, start, steps_of};
+
+/// Runs `options` to the end (or to a signal): loads, steps, prints the summary, writes the
+/// outputs.
+pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
+    check_outputs(&options)?;
+    if options.every == Some(0) {
+        bail!("--every must be at least 1");
+    }
+    let interrupts = Interrupts::install()?;
+    let (mut app, mut progress, source, dt) = match &options.input {
+        Input::Resume(path) => {
+            let spawn = options.placement.is_some() || options.area_fraction.is_some();
+            if options.solver.is_some() || options.dt.is_some() || options.seed.is_some() || spawn {
+                bail!(
+                    "--resume goes on with the checkpoint's settings: no --solver, --dt, --seed, \
+                     --placement or --area-fraction"
+                );
+            }
+            let checkpoint = Checkpoint::read(path)?;
+            let source = checkpoint.source.clone();
+            let origin = path.display().to_string();
+            let (app, progress) = checkpoint.resume(&origin)?;
+            let dt = app
+                .world()
+                .resource::<bevy::time::Time<bevy::time::Fixed>>();
+            let dt = dt.timestep().as_secs_f64();
+            (app, progress, source, dt)
+        }
+        input => {
+            let (config, source) = configure(input, &options)?;
+            let dt = config.dt;
+            set_threads(options.threads);
+            let mut app = start(config, &source)?;
+            let progress = Progress::start(app.world_mut());
+            (app, progress, source, dt)
+        }
+    };
+    app.insert_resource(interrupts.stop_request());
+    let steps = steps_of(options.length, dt)?;
+    let first = app.world().resource::<StepTotals>().steps;
+    let until = first.saturating_add(steps);
+    let bar = indicatif::ProgressBar::new(steps).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  eta {eta}")
+            .expect("valid template"),
+    );
+    let sampling = default_sampling(app.world().resource::<crate::spawn::SpawnReport>().placed);
+    // What could not be written; the other outputs are written all the same.
+    let mut failed: Vec<anyhow::Error> = Vec::new();
+    let stopped = loop {
+        let now = app.world().resource::<StepTotals>().steps;
+        let next = match (&options.checkpoint, options.every) {
+            (Some(_), Some(every)) => until.min((now / every + 1).saturating_mul(every)),
+            _ => until,
+        };
+        let stop = || interrupts.raised().is_some();
+        let stopped = advance(&mut app, &mut progress, next, sampling, stop, |s| {
+            bar.set_position(s.step - first)
+        });
+        if stopped || next >= until {
+            break stopped;
+        }
+        if let Some(path) = &options.checkpoint
+            && let Err(e) = write_checkpoint(&mut app, &source, &progress, path)
+        {
+            // A periodic checkpoint that cannot be written (a full disk) ends the run here,
+            // with the report and the dump of where it got to.
+            failed.push(e);
+            break true;
+        }
+    };
+    let checkpoint_failed = !failed.is_empty();
+    bar.finish_and_clear();
+
+    let mut ended = progress;
+    sample_end(&mut app, &mut ended, sampling, |_| {});
+    let mut report = Report::new(app.world_mut(), &source, &ended);
+    report.interrupted = stopped;
+    print_summary(&report);
+    if !report.is_finite() {
+        bail!(
+            "the run's state became non-finite ({} circles); nothing was written",
+            report.non_finite
+        );
+    }
+    if let Some(path) = &options.report {
+        let json = serde_json::to_string_pretty(&report).context("serialising the report")?;
+        if let Err(e) = write_atomically(path, (json + "\n").as_bytes()) {
+            failed.push(
+                anyhow::Error::new(e).context(format!("writing the report to {}", path.display())),
+            );
+        }
+    }
+    if let Some(path) = &options.dump {
+        let state = snapshot(app.world_mut());
+        if let Err(e) = write_atomically(path, particles::format(&state).as_bytes()) {
+            failed.push(
+                anyhow::Error::new(e)
+                    .context(format!("writing the final state to {}", path.display())),
+            );
+        }
+    }
+    // Once failed, the checkpoint is not tried again: the run stopped where it failed.
+    if let Some(path) = &options.checkpoint
+        && !checkpoint_failed
+        && let Err(e) = write_checkpoint(&mut app, &source, &progress, path)
+    {
+        failed.push(e);
+    }
+    if !failed.is_empty() {
+        let all: Vec<String> = failed.iter().map(|e| format!("{e:#}")).collect();
+        bail!("{} (the other outputs were written)", all.join("; "));
+    }
+    Ok(match interrupts.raised() {
+        Some(signal) if stopped => {
+            say(format_args!(
+                "interrupted by signal {signal} after step {}; outputs written",
+                report.steps
+            ));
+            Finished::Interrupted { signal }
+        }
+        _ => Finished::Completed,
+    })
+}
+
+/// SIGINT and SIGTERM, caught: the first asks the run to stop after the current step; a second
+/// ends the process at once with 130 / 143, leaving every output as it was (each is replaced
+/// whole or not at all).
+struct Interrupts {
+    signal: Arc<AtomicUsize>,
+    /// Set by the first signal: what a long step polls ([`StopRequest`]).
+    once: Arc<AtomicBool>,
+}
+
+impl Interrupts {
+    fn install() -> anyhow::Result<Self> {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        use signal_hook::flag;
+        let once = Arc::new(AtomicBool::new(false));
+        let signal = Arc::new(AtomicUsize::new(0));
+        for (number, code) in [(SIGINT, 130), (SIGTERM, 143)] {
+            // Handlers run in the order registered: the exit checks the flag before it is set.
+            flag::register_conditional_shutdown(number, code, Arc::clone(&once))
+                .and_then(|_| flag::register(number, Arc::clone(&once)))
+                .and_then(|_| flag::register_usize(number, Arc::clone(&signal), number as usize))
+                .context("installing the signal handlers")?;
+        }
+        Ok(Self { signal, once })
+    }
+
+    /// The request a long step polls, to end the step at once after the first signal.
+    fn stop_request(&self) -> StopRequest {
+        StopRequest(Arc::clone(&self.once))
+    }
+
+    /// The signal that asked the run to stop, if one did.
+    fn raised(&self) -> Option<i32> {
+        match self.signal.load(Ordering::Relaxed) {
+            0 => None,
+            n => Some(n as i32),
+        }
+    }
+}
+
+fn write_checkpoint(
+    app: &mut App,
+    source: &str,
+    progress: &Progress,
+    path: &std::path::Path,
+) -> anyhow::Result<()> {
+    let bytes = Checkpoint::take(app.world_mut(), source, progress).to_bytes();
+    write_atomically(path, &bytes)
+        .with_context(|| format!("writing the checkpoint to {}", path.display()))
+}
+
+fn print_summary(r: &Report) {
+    say(format_args!(
+        "{} circles, {}, {} steps of {:.6} s in {:.3} s ({:.4} ms/step)",
+        r.n, r.solver, r.steps, r.dt, r.wall_seconds, r.ms_per_step
+    ));
+    say(format_args!(
+        "energy drift {:+.3e}, max penetration {:.3e}, collisions {} pair / {} wall, escaped {}, non-finite {}",
+        r.energy_drift,
+        r.max_penetration,
+        r.pair_collisions,
+        r.wall_collisions,
+        r.escaped,
+        r.non_finite
+    ));
+}
