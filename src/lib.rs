@@ -126,7 +126,7 @@
 //! - [`io`]: writing outputs atomically and reading inputs of untrusted size;
 //! - [`run`]: the headless app and the one stepping loop;
 //! - [`checkpoint`]: a run's whole state, to resume bit for bit;
-//! - [`commands`]: the work behind each `moving_circles` command;
+//! - [`commands`] (feature `cli`): the work behind each `moving_circles` command;
 //! - [`accuracy`]: the accuracy study of every solver against `exact`;
 //! - [`eos`]: the hard-disk equation of state.
 //!
@@ -159,6 +159,7 @@ pub mod boundary;
 pub mod checkpoint;
 pub mod circle;
 pub mod collide;
+#[cfg(feature = "cli")]
 pub mod commands;
 pub mod components;
 pub mod config;
@@ -167,6 +168,7 @@ pub mod effects;
 pub mod eos;
 pub mod error;
 pub mod exact;
+#[cfg(feature = "cli")]
 mod figure;
 pub mod forces;
 mod grid;

@@ -14,6 +14,7 @@ pub mod auto;
 pub mod front;
 pub mod measure;
 pub mod piles;
+#[cfg(feature = "cli")]
 pub mod plot;
 pub mod report;
 

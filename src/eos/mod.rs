@@ -11,6 +11,7 @@
 //! `kT = ½`; the step is about one mean free time (from Henderson's contact value), so a step
 //! holds about one collision per disk.
 
+#[cfg(feature = "cli")]
 pub mod plot;
 pub mod theory;
 
