@@ -7,15 +7,14 @@ use std::os::unix::fs::FileTypeExt;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
+use common::binary::{assert_refused, moving_circles, under_one_gib};
 use moving_circles::config::MAX_CIRCLES;
 
-fn moving_circles(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_moving_circles"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("DISPLAY", "")
-        .args(args)
-        .output()
-        .expect("runs")
+mod common;
+
+/// A scratch folder for the test `name`.
+fn temp_dir(name: &str) -> PathBuf {
+    common::binary::scratch_dir("hostile", name)
 }
 
 /// `run` on two steps of the classic scene, with `extra` flags.
@@ -29,24 +28,6 @@ fn run_classic(extra: &[&str]) -> Output {
     ];
     args.extend_from_slice(extra);
     moving_circles(&args)
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mc-hostile-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Asserts the run was refused with exit code 1 and one line on stderr that contains every
-/// `expected` piece, and that nothing panicked or aborted.
-fn assert_refused(out: &Output, expected: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "exit status, stderr:\n{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "one line:\n{stderr}");
-    for piece in expected {
-        assert!(stderr.contains(piece), "expected `{piece}` in:\n{stderr}");
-    }
 }
 
 #[test]
@@ -217,20 +198,6 @@ fn outputs_go_to_regular_files_only_and_never_to_one_file_twice() {
         .collect();
     assert!(report.exists() && left.is_empty(), "{left:?}");
     std::fs::remove_dir_all(&dir).unwrap();
-}
-
-/// `moving_circles` under a 1 GiB address-space limit: what "no more than 1 GB before refusing"
-/// means, enforced by the kernel instead of measured.
-fn under_one_gib(args: &[&str]) -> Output {
-    let binary = env!("CARGO_BIN_EXE_moving_circles");
-    Command::new("sh")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .arg("-c")
-        .arg(r#"ulimit -v 1048576 && exec "$0" "$@""#)
-        .arg(binary)
-        .args(args)
-        .output()
-        .expect("runs")
 }
 
 #[test]

@@ -4,30 +4,15 @@
 #![cfg(unix)]
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Command;
 
-/// `moving_circles` under a 1 GiB address-space limit (as in `tests/hostile.rs`).
-fn under_one_gib(args: &[&str]) -> Output {
-    let binary = env!("CARGO_BIN_EXE_moving_circles");
-    Command::new("sh")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("DISPLAY", "")
-        .arg("-c")
-        .arg(r#"ulimit -v 1048576 && exec "$0" "$@""#)
-        .arg(binary)
-        .args(args)
-        .output()
-        .expect("runs")
-}
+use common::binary::{assert_refused, stderr, under_one_gib};
 
+mod common;
+
+/// A scratch folder for the test `name`.
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mc-hostile2-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
+    common::binary::scratch_dir("hostile2", name)
 }
 
 #[test]
@@ -95,12 +80,7 @@ fn a_refused_compression_names_its_scene() {
     .unwrap();
     let scene = scene.to_str().unwrap();
     let out = under_one_gib(&["run", "--scene", scene, "--steps", "1"]);
-    let err = stderr(&out);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains(scene) && err.contains("spawn.placement"),
-        "{err}"
-    );
+    assert_refused(&out, &[scene, "spawn.placement"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -114,10 +94,8 @@ fn an_equation_of_state_of_too_many_disks_blames_n() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    let err = stderr(&out);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("n: needs 2 to 5000000 disks"), "{err}");
-    assert!(!err.contains("spawn.radius"), "{err}");
+    assert_refused(&out, &["n: needs 2 to 5000000 disks"]);
+    assert!(!stderr(&out).contains("spawn.radius"), "{}", stderr(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -195,12 +173,7 @@ fn an_output_never_replaces_the_runs_own_input() {
     let scene = scene.to_str().unwrap();
     for flag in ["--report", "--dump", "--checkpoint"] {
         let out = under_one_gib(&["run", "--scene", scene, "--steps", "2", flag, scene]);
-        let err = stderr(&out);
-        assert_eq!(out.status.code(), Some(1), "{flag}: {err}");
-        assert!(
-            err.contains(&format!("{flag} names the input of --scene")),
-            "{err}"
-        );
+        assert_refused(&out, &[&format!("{flag} names the input of --scene")]);
     }
     assert_eq!(
         std::fs::read_to_string(scene).unwrap(),
@@ -224,8 +197,7 @@ fn an_output_never_replaces_the_runs_own_input() {
     let out = under_one_gib(&[&again[..], &["--checkpoint", checkpoint]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
     let out = under_one_gib(&[&again[..], &["--report", checkpoint]].concat());
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("--report names the input of --resume"));
+    assert_refused(&out, &["--report names the input of --resume"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -2,6 +2,8 @@
 //! per `update()`, and assertion helpers that say what was expected.
 #![allow(dead_code)] // each test file uses its own subset
 
+pub mod binary;
+
 use std::hash::{DefaultHasher, Hash, Hasher};
 
 use bevy::math::DVec2;

@@ -1,0 +1,56 @@
+//! Helpers for the tests that run the real binary: run it (under a 1 GiB address-space limit
+//! where memory is the promise), a scratch folder per test, and the refusal every bad input
+//! must get.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// `moving_circles` with `args`, from the crate's folder, with no display.
+pub fn moving_circles(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("DISPLAY", "")
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+/// `moving_circles` under a 1 GiB address-space limit: what "no more than 1 GB before refusing"
+/// means, enforced by the kernel instead of measured.
+pub fn under_one_gib(args: &[&str]) -> Output {
+    let binary = env!("CARGO_BIN_EXE_moving_circles");
+    Command::new("sh")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("DISPLAY", "")
+        .arg("-c")
+        .arg(r#"ulimit -v 1048576 && exec "$0" "$@""#)
+        .arg(binary)
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+/// A fresh folder for the test `name` of the test file `file`, in the system's temporary
+/// folder.
+pub fn scratch_dir(file: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mc-{file}-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// What the run wrote to stderr.
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Asserts the run was refused with exit code 1 and one line on stderr that contains every
+/// `expected` piece, and that nothing panicked or aborted.
+pub fn assert_refused(out: &Output, expected: &[&str]) {
+    let stderr = stderr(out);
+    assert_eq!(out.status.code(), Some(1), "exit status, stderr:\n{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "one line:\n{stderr}");
+    for piece in expected {
+        assert!(stderr.contains(piece), "expected `{piece}` in:\n{stderr}");
+    }
+}
