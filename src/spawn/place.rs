@@ -56,7 +56,7 @@ pub fn place_circles(
     radii.sort_by(|a, b| b.total_cmp(a));
     // A compression places the circles shrunk by `loose` first, then grows them back.
     let loose = match config.placement {
-        Placement::Pack => pack_start(arena, &radii, fixed, segments)?,
+        Placement::Pack => pack_start(arena, config, &radii, (fixed, segments))?,
         _ => 1.0,
     };
 
@@ -134,13 +134,18 @@ pub fn place_circles(
     Ok(random)
 }
 
-/// How much a `pack` placement shrinks circles of these `radii` to place them at
-/// [`PACK_START_FRACTION`] of the area at most, or why it cannot pack around what is there.
+/// The densest packing of equal disks in the plane covers this much of it (hexagonal, π/√12):
+/// no compression gets past it, and walls and mixed radii jam it sooner.
+pub const DENSEST_PACKING: f64 = 0.906_899_682_117_108_9;
+
+/// How much a `pack` placement (of `config`) shrinks circles of these `radii` to place them at
+/// [`PACK_START_FRACTION`] of the area at most, or why it cannot pack around what is there, or
+/// cannot reach that area fraction at all (refused at once, before minutes of compression).
 fn pack_start(
     arena: &Arena,
+    config: &SpawnConfig,
     radii: &[f64],
-    fixed: &[CircleState],
-    segments: &[Segment],
+    (fixed, segments): (&[CircleState], &[Segment]),
 ) -> Result<f64, FieldError> {
     if !fixed.is_empty() || !segments.is_empty() {
         return Err(FieldError::new(
@@ -151,6 +156,21 @@ fn pack_start(
         .within("spawn"));
     }
     let fraction = arena.area_fraction(radii.iter().copied());
+    if fraction > DENSEST_PACKING {
+        let field = match config.area_fraction {
+            Some(_) => "area_fraction",
+            None => "count",
+        };
+        return Err(FieldError::new(
+            field,
+            format!(
+                "the circles would cover {fraction:.4} of the arena; no packing of disks covers \
+                 more than {DENSEST_PACKING:.4}, so a compression cannot get there: ask for \
+                 fewer or smaller circles"
+            ),
+        )
+        .within("spawn"));
+    }
     Ok((PACK_START_FRACTION / fraction).sqrt().min(1.0))
 }
 
@@ -325,6 +345,26 @@ mod tests {
         };
         let err = place_circles(&arena, &bad_speed, &[], &[]).unwrap_err();
         assert!(err.to_string().starts_with("spawn.speed"), "{err}");
+    }
+
+    #[test]
+    fn a_compression_past_the_densest_packing_is_refused_at_once() {
+        // 1000 circles of radius 0.1 in a unit square: 31 times its area.
+        let arena = Arena::centered(DVec2::ONE);
+        let overfull = SpawnConfig {
+            count: 1000,
+            radius: (0.1, 0.1),
+            placement: Placement::Pack,
+            ..Default::default()
+        };
+        let err = place_circles(&arena, &overfull, &[], &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("spawn.count"), "{err}");
+        assert!(
+            err.contains("cover 31.4") && err.contains("0.9069"),
+            "{err}"
+        );
     }
 
     #[test]
