@@ -124,9 +124,18 @@ fn a_dump_of_static_circles_reads_back_as_the_same_circles() {
         first.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
+    let static_lines = |t: &str| -> Vec<String> {
+        t.lines()
+            .filter(|l| l.contains(" inf "))
+            .map(str::to_owned)
+            .collect()
+    };
     let text = std::fs::read_to_string(&first).unwrap();
-    let statics = text.lines().filter(|l| l.contains(" inf ")).count();
-    assert_eq!(statics, 2, "the pegs in the dump:\n{text}");
+    assert_eq!(
+        static_lines(&text).len(),
+        2,
+        "the pegs in the dump:\n{text}"
+    );
     // The dump is a particle file: it reads back, its static circles still static.
     let out = under_one_gib(&[
         "run",
@@ -141,12 +150,6 @@ fn a_dump_of_static_circles_reads_back_as_the_same_circles() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let again = std::fs::read_to_string(&second).unwrap();
-    let static_lines = |t: &str| -> Vec<String> {
-        t.lines()
-            .filter(|l| l.contains(" inf "))
-            .map(str::to_owned)
-            .collect()
-    };
     assert_eq!(static_lines(&text), static_lines(&again), "the pegs moved");
     // A moving static circle is still refused, naming its line.
     let moving = dir.join("moving.txt");

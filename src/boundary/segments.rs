@@ -152,35 +152,41 @@ fn bounce_off_segments(
         let (mut p, mut v) = (position.0, velocity.0);
         let from = p;
         // Each push may press the circle into another segment (a narrow V): a few passes
-        // settle it, each bounce counted as a hit.
-        for &k in near.iter().cycle().take(SEGMENT_PASSES * near.len()) {
-            let before = v;
-            let Some(bounce) =
-                reflect_off_segment(&mut p, &mut v, radius.0, &segments.0[k as usize], e, from)
-            else {
-                continue;
-            };
-            hits += 1;
-            let delta = mass.0 * (v - before).length();
-            if delta.is_finite() {
-                impulse += delta;
+        // settle it, each bounce counted as a hit; a pass that changes nothing ends them.
+        for _ in 0..SEGMENT_PASSES {
+            let pass_start = (p, v);
+            for &k in near.iter() {
+                let before = v;
+                let Some(bounce) =
+                    reflect_off_segment(&mut p, &mut v, radius.0, &segments.0[k as usize], e, from)
+                else {
+                    continue;
+                };
+                hits += 1;
+                let delta = mass.0 * (v - before).length();
+                if delta.is_finite() {
+                    impulse += delta;
+                }
+                if effects.hit_messages {
+                    log.walls.push(WallHit {
+                        circle: entities.len() as u32,
+                        wall: Wall::Segment(k),
+                        point: bounce.point,
+                        normal: bounce.normal,
+                        impulse: if mass.0.is_finite() {
+                            delta
+                        } else {
+                            f64::INFINITY
+                        },
+                        normal_speed: bounce.normal_speed,
+                        time: 0.0,
+                        count: 1,
+                    });
+                    entities.push(entity);
+                }
             }
-            if effects.hit_messages {
-                log.walls.push(WallHit {
-                    circle: entities.len() as u32,
-                    wall: Wall::Segment(k),
-                    point: bounce.point,
-                    normal: bounce.normal,
-                    impulse: if mass.0.is_finite() {
-                        delta
-                    } else {
-                        f64::INFINITY
-                    },
-                    normal_speed: bounce.normal_speed,
-                    time: 0.0,
-                    count: 1,
-                });
-                entities.push(entity);
+            if (p, v) == pass_start {
+                break;
             }
         }
         if p != position.0 {
