@@ -17,6 +17,7 @@ use crate::collide::PairCollisions;
 use crate::components::Sleep;
 use crate::config::{
     CirclesConfig, DropConfig, Effects, MAX_CIRCLES, MassModel, SoftConfig, Solver, SpawnConfig,
+    min_radius,
 };
 use crate::error::InputError;
 use crate::exact::EngineState;
@@ -107,6 +108,26 @@ impl Checkpoint {
         }
     }
 
+    /// Every circle, in spawn order.
+    pub fn circles(&self) -> &[CircleState] {
+        &self.circles
+    }
+
+    /// The arena the circles are in.
+    pub fn arena(&self) -> &Arena {
+        &self.arena
+    }
+
+    /// The segment walls.
+    pub fn segments(&self) -> &Segments {
+        &self.segments
+    }
+
+    /// The solver the run goes on with.
+    pub fn solver(&self) -> Solver {
+        self.solver
+    }
+
     /// The checkpoint as bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
         postcard::to_stdvec(self).expect("a checkpoint is plain data")
@@ -194,8 +215,14 @@ impl Checkpoint {
                 })
                 .map_err(|e| e.within(&format!("circles[{i}]")))
                 .map_err(describe)?;
-            if !(c.radius > 0.0 && 2.0 * c.radius <= self.arena.size().min_element()) {
-                return Err(format!("circle {i} has an impossible radius {}", c.radius));
+            // The radii a scene may give (a radius below the rounding of positions has
+            // overlaps no float can measure).
+            let radii = min_radius(&self.arena)..=0.5 * self.arena.size().min_element();
+            if !radii.contains(&c.radius) {
+                return Err(format!(
+                    "circle {i} has an impossible radius {:?}",
+                    c.radius
+                ));
             }
             // Every step ends with each centre inside (put back or wrapped): one outside means
             // the circle or the arena was changed.
@@ -218,7 +245,8 @@ impl Checkpoint {
         if numbers.iter().any(|x| !x.is_finite()) {
             return Err("a counter or total is not finite".to_owned());
         }
-        if self.engine.is_some() != (self.solver == Solver::Exact && !self.circles.is_empty()) {
+        // No engine under `exact` is a build a signal stopped: the next step builds one.
+        if self.engine.is_some() && self.solver != Solver::Exact {
             return Err("the engine state does not match the solver".to_owned());
         }
         if let Some(contacts) = &self.contacts {
@@ -332,5 +360,12 @@ mod tests {
         moved.arena.min = DVec2::splat(-1e20);
         moved.arena.max = DVec2::splat(-1e19);
         assert!(Checkpoint::from_bytes(&moved.to_bytes(), "c").is_err());
+        // A radius a scene could not give: overlaps of it are not measurable.
+        let mut tiny = good.clone();
+        tiny.circles[3].radius = 1e-310;
+        let error = Checkpoint::from_bytes(&tiny.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("impossible radius"), "{error}");
     }
 }

@@ -93,16 +93,18 @@ pub struct CircleDiagnostics {
 
 impl CircleDiagnostics {
     /// Relative change of the mechanical energy since the last reset: `(E - E0) / |E0|`, or the
-    /// absolute change when `E0` is zero (so it is always finite).
+    /// absolute change when `E0` is zero or all but zero (so it is always finite).
     pub fn energy_drift(&self) -> f64 {
         relative_change(self.initial_energy, self.energy)
     }
 }
 
-/// `(now - before) / |before|`, falling back to `now - before` when `before` is zero.
+/// `(now - before) / |before|`, falling back to `now - before` when `before` is zero or so
+/// small (a subnormal energy of circles all but at rest) that the ratio overflows.
 pub fn relative_change(before: f64, now: f64) -> f64 {
-    if before != 0.0 {
-        (now - before) / before.abs()
+    let ratio = (now - before) / before.abs();
+    if before != 0.0 && ratio.is_finite() {
+        ratio
     } else {
         now - before
     }
@@ -244,6 +246,14 @@ fn take_baseline(
 mod tests {
     use super::*;
     use crate::arena::Boundary;
+
+    #[test]
+    fn a_change_from_nothing_or_next_to_nothing_is_finite() {
+        assert_eq!(relative_change(2.0, 3.0), 0.5);
+        assert_eq!(relative_change(0.0, 3.0), 3.0);
+        // From a subnormal energy the ratio would be infinite.
+        assert_eq!(relative_change(1.5e-314, 1.0), 1.0 - 1.5e-314);
+    }
 
     /// A gas that all but stopped (inelastic hits under a huge gravity) after large impulses:
     /// `z` overflows an f64 and is reported as undefined, not as infinity.

@@ -233,7 +233,8 @@ pub struct Report {
     pub energy_initial: f64,
     /// Mechanical energy at the end.
     pub energy_final: f64,
-    /// `(final - initial) / |initial|`, or the absolute change when the initial energy is 0.
+    /// `(final - initial) / |initial|`, or the absolute change when the initial energy is 0 or
+    /// so small that the ratio overflows.
     pub energy_drift: f64,
     /// Total momentum `[x, y]` at the start.
     pub momentum_initial: [f64; 2],

@@ -5,15 +5,20 @@
 //! - [`particles`]: any bytes as a particle file, under both boundaries.
 //! - [`scene`]: any bytes as a scene file (read with the scene limit, RON, every value checked).
 //! - [`simulate`]: what either reader accepts, run for a few steps under every solver.
+//! - [`checkpoint`]: any bytes as a checkpoint (the kept corpus holds true checkpoints of small
+//!   runs, which libFuzzer mutates); what is accepted is resumed and run a few steps.
 
 use moving_circles::arena::{Arena, Boundary};
+use moving_circles::checkpoint::Checkpoint;
 use moving_circles::circle::CircleState;
 use moving_circles::config::{CirclesConfig, MAX_CIRCLES, Solver};
 use moving_circles::error::InputError;
 use moving_circles::io::{MAX_SCENE_BYTES, read_limited};
-use moving_circles::run::{Report, headless_app, run_steps};
+use moving_circles::run::{Report, advance, headless_app, run_steps};
 use moving_circles::scene::check::{check_circle, first_overlap};
 use moving_circles::scene::{Scene, particles as particle_file};
+use moving_circles::schedule::StepTotals;
+use moving_circles::segment::{SegmentCells, Segments};
 
 /// Most circles [`simulate`] runs: inputs asking for more are only read and checked. With
 /// [`SIMULATED_STEPS`] this bounds an execution: `exact` processes at most
@@ -79,7 +84,73 @@ pub fn simulate(data: &[u8]) {
     }
     for solver in SOLVERS {
         let report = run(&config, solver);
-        check_report(&report, solver);
+        check_report(&report, solver, true);
+    }
+}
+
+/// Any bytes as a checkpoint: refused with a clear one-line error, or accepted as one that is
+/// written back to bytes that are read back the same. An accepted checkpoint of at most
+/// [`MAX_SIMULATED_CIRCLES`] resumes or is refused the same way, and then runs
+/// [`SIMULATED_STEPS`] under its own solver with the promises of [`simulate`] (overlap only
+/// if it began with none, of circles or of segment walls: a checkpoint of a time-stepped run
+/// may hold overlaps, and an edit of the solver or a wall is not a damage the reader can see);
+/// the checkpoint of where it ends is read back.
+pub fn checkpoint(data: &[u8]) {
+    let checkpoint = match Checkpoint::from_bytes(data, ORIGIN) {
+        Ok(checkpoint) => checkpoint,
+        Err(error) => {
+            refused::<()>(&error);
+            return;
+        }
+    };
+    let written = checkpoint.to_bytes();
+    read_back(&written, "an accepted checkpoint");
+    if checkpoint.circles().len() > MAX_SIMULATED_CIRCLES {
+        return;
+    }
+    let (solver, source) = (checkpoint.solver(), checkpoint.source.clone());
+    let began_apart = apart(
+        checkpoint.circles(),
+        checkpoint.arena(),
+        checkpoint.segments(),
+    );
+    let (mut app, mut progress) = match checkpoint.resume(ORIGIN) {
+        Ok(resumed) => resumed,
+        Err(error) => {
+            refused::<()>(&error);
+            return;
+        }
+    };
+    // The overlaps the checkpoint says the run saw are its own: judge the steps run here.
+    progress.overlaps = Default::default();
+    let until = app.world().resource::<StepTotals>().steps + SIMULATED_STEPS;
+    advance(&mut app, &mut progress, until, 1, || false, |_| {});
+    let report = Report::new(app.world_mut(), ORIGIN, &progress);
+    check_report(&report, solver, began_apart);
+    let end = Checkpoint::take(app.world_mut(), &source, &progress).to_bytes();
+    read_back(&end, "the checkpoint of a resumed run");
+}
+
+/// Whether no two circles overlap and none touches a segment wall: what the continuous solvers
+/// keep from there on.
+fn apart(circles: &[CircleState], arena: &Arena, segments: &Segments) -> bool {
+    let walls = SegmentCells::over_arena(&segments.0, arena);
+    first_overlap(circles, arena).is_none()
+        && circles.iter().all(|c| {
+            walls
+                .first_touched(&segments.0, c.position, c.radius)
+                .is_none()
+        })
+}
+
+/// A checkpoint we wrote must be read back, and written again to the same bytes.
+fn read_back(bytes: &[u8], what: &str) {
+    match Checkpoint::from_bytes(bytes, ORIGIN) {
+        Ok(again) => assert!(
+            again.to_bytes() == bytes,
+            "{what} is written back otherwise"
+        ),
+        Err(error) => panic!("{what} is refused when read back: {error}"),
     }
 }
 
@@ -153,8 +224,8 @@ fn run(config: &CirclesConfig, solver: Solver) -> Report {
     run_steps(&mut app, ORIGIN, SIMULATED_STEPS, 1, |_| {})
 }
 
-/// The promises every run keeps, and those of the continuous solvers.
-fn check_report(report: &Report, solver: Solver) {
+/// The promises every run keeps, and those of the continuous solvers on circles that `began_apart`.
+fn check_report(report: &Report, solver: Solver, began_apart: bool) {
     assert_eq!(
         report.non_finite, 0,
         "{solver}: non-finite circles: {report:?}"
@@ -167,7 +238,7 @@ fn check_report(report: &Report, solver: Solver) {
         report.escaped, 0,
         "{solver}: circles left the arena: {report:?}"
     );
-    if solver.is_continuous() && report.budget_exhausted == 0 {
+    if began_apart && solver.is_continuous() && report.budget_exhausted == 0 {
         assert!(
             report.max_penetration <= ROUNDING,
             "{solver}: overlap {:e} beyond rounding: {report:?}",
