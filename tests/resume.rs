@@ -1,7 +1,8 @@
 //! Checkpoint, resume and interruption through the real binary: a run paused at a checkpoint
 //! and resumed ends bit for bit where the run without the pause ends, under every solver; a
 //! signal ends a run after a whole step with its report, final state and checkpoint written,
-//! and a second signal ends it at once without touching what was there. And, in the library, a
+//! and a second signal ends it at once without touching what was there; a signal while the
+//! circles are being placed ends it at once, writing nothing. And, in the library, a
 //! resumed `exact` app goes on with the engine it restored instead of rebuilding one.
 #![cfg(unix)]
 
@@ -263,6 +264,56 @@ fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
     assert_eq!(report["budget_exhausted"].as_u64(), Some(1), "{report}");
     assert!(
         took < Duration::from_secs(2),
+        "the run took {took:?} to stop"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
+    let dir = temp_dir("placing");
+    let (scene, report) = (dir.join("big.ron"), dir.join("r.json"));
+    // Four million circles: seconds to place, minutes in a test build.
+    std::fs::write(
+        &scene,
+        "(arena: (size: (560.0, 560.0), boundary: periodic), effects: (collisions: true), \
+         spawn: (count: 4000000, radius: (0.05, 0.1), seed: 1))",
+    )
+    .unwrap();
+    std::fs::write(&report, "old").unwrap();
+    let mut child = command(&[
+        "run",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--steps",
+        "10",
+        "--report",
+        report.to_str().unwrap(),
+    ])
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .unwrap();
+    // The run says it is placing them, then places them: the signal comes while it does.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut said = String::new();
+    std::io::BufRead::read_line(&mut stderr, &mut said).unwrap();
+    assert!(said.contains("placing at random"), "{said}");
+    signal(&child, "TERM");
+    let sent = Instant::now();
+    let status = child.wait().unwrap();
+    let took = sent.elapsed();
+    let mut stdout = String::new();
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
+    assert_eq!(status.code(), Some(143), "{stdout}");
+    assert!(stdout.contains("while placing circles"), "{stdout}");
+    assert_eq!(
+        text(&report),
+        "old",
+        "nothing was run, so nothing is replaced"
+    );
+    assert!(
+        took < Duration::from_secs(1),
         "the run took {took:?} to stop"
     );
     std::fs::remove_dir_all(&dir).unwrap();

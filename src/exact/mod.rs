@@ -201,7 +201,7 @@ fn continuous_step(
     lost_restitution.clear();
     let with_own_restitution = !own_restitution.is_empty();
     gather_into_engine(
-        (*solver, *arena, *effects, &segments),
+        ((*solver, *arena, *effects, &segments), stop.as_deref()),
         &mut state,
         (restitution_lost, with_own_restitution),
         &mut circles,
@@ -249,9 +249,10 @@ fn write_back_sleep(state: &EngineState, sleep: &mut Query<&mut Sleep>) -> usize
 /// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
 /// paddle); otherwise (and always for `swept`) builds a fresh one from the circles. Says which
 /// in a debug log. `restitution` says whether a circle lost its own restitution since the last
-/// step, and whether any has one.
+/// step, and whether any has one. A build that `stop` ends leaves no engine: the step then
+/// moves nothing and counts in `budget_exhausted`.
 fn gather_into_engine(
-    setup: (Solver, Arena, Effects, &Segments),
+    (setup, stop): ((Solver, Arena, Effects, &Segments), Option<&StopRequest>),
     state: &mut EngineState,
     restitution: (bool, bool),
     circles: &mut ParamSet<(SolverCircles, ChangedCircles, Query<&mut Sleep>)>,
@@ -310,9 +311,18 @@ fn gather_into_engine(
         })
         .collect();
     let restitutions = (effects.restitution, effects.wall_restitution);
-    let mut engine = match effects.gravity {
-        Some(g) => EventEngine::falling(&bodies, &arena, &segments.0, restitutions, g, &rest),
-        None => EventEngine::new(&bodies, &arena, &segments.0, restitutions.0, restitutions.1),
+    let stopped = || stop.is_some_and(StopRequest::raised);
+    let fall = (effects.gravity, &rest[..]);
+    let Some(mut engine) =
+        EventEngine::build_until(&bodies, &arena, &segments.0, restitutions, fall, stopped)
+    else {
+        // Stopped before every circle was predicted: this step moves nothing, and the next
+        // one builds again.
+        debug!("exact engine: build stopped by a stop request");
+        state.engine = None;
+        state.setup = None;
+        state.budget_exhausted += 1;
+        return;
     };
     if with_own_restitution {
         engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());

@@ -34,12 +34,14 @@ pub struct Jammed {
 /// Lubachevsky–Stillinger dynamics: each flies at the largest loose diameter per unit time in
 /// the direction of its own velocity (or, at rest, one of its own), while the radii grow at
 /// [`PACK_GROWTH`] of that. Returns the circles at their grown radii, each with its own speed
-/// again in the direction the compression left it moving.
+/// again in the direction the compression left it moving; or `None` if `stop` said so (asked
+/// at each stage and every [`STOP_POLL_EVENTS`](super::engine::STOP_POLL_EVENTS) events).
 pub fn compress(
     loose: &[CircleState],
     arena: &Arena,
     scale: f64,
-) -> Result<Vec<CircleState>, Jammed> {
+    stop: impl Fn() -> bool,
+) -> Result<Option<Vec<CircleState>>, Jammed> {
     assert!(scale >= 1.0 && scale.is_finite());
     let n = loose.len();
     let largest = loose.iter().map(|c| c.radius).fold(0.0, f64::max);
@@ -64,7 +66,13 @@ pub fn compress(
     let budget = PACK_EVENTS_PER_CIRCLE.saturating_mul(n as u64);
     for stage in 1..=PACK_STAGES {
         let end = until * f64::from(stage) / f64::from(PACK_STAGES);
-        if engine.advance_to(end, budget).is_err() {
+        if stop() {
+            return Ok(None);
+        }
+        if engine.advance_until_stopped(end, budget, &stop).is_err() {
+            if stop() {
+                return Ok(None);
+            }
             let fraction = arena.area_fraction(loose.iter().map(|c| c.radius));
             let grown = |t: f64| fraction * (1.0 + PACK_GROWTH * t).powi(2);
             return Err(Jammed {
@@ -79,14 +87,36 @@ pub fn compress(
             engine.rescale_speeds(speed / (mean_square / n as f64).sqrt());
         }
     }
-    Ok(loose
-        .iter()
-        .enumerate()
-        .map(|(i, c)| CircleState {
-            position: engine.position(i),
-            velocity: engine.velocity(i).normalize_or_zero() * c.velocity.length(),
-            radius: c.radius * scale,
-            ..*c
-        })
-        .collect())
+    Ok(Some(
+        loose
+            .iter()
+            .enumerate()
+            .map(|(i, c)| CircleState {
+                position: engine.position(i),
+                velocity: engine.velocity(i).normalize_or_zero() * c.velocity.length(),
+                radius: c.radius * scale,
+                ..*c
+            })
+            .collect(),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arena::Boundary;
+
+    #[test]
+    fn a_compression_asked_to_stop_gives_up_and_one_never_asked_grows_the_circles() {
+        let arena = Arena::unit_square(Boundary::Periodic);
+        let loose: Vec<CircleState> = (0..400)
+            .map(|i| {
+                let at = DVec2::new((i % 20) as f64 + 0.5, (i / 20) as f64 + 0.5) / 20.0;
+                CircleState::new(at, DVec2::from_angle(i as f64), 0.01)
+            })
+            .collect();
+        assert_eq!(compress(&loose, &arena, 1.5, || true), Ok(None));
+        let grown = compress(&loose, &arena, 1.5, || false).unwrap().unwrap();
+        assert!(grown.iter().all(|c| c.radius == 0.015));
+    }
 }

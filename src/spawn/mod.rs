@@ -14,12 +14,12 @@ use crate::components::Position;
 use crate::components::Radius;
 use crate::config::{DropConfig, SpawnConfig};
 use crate::schedule::CircleSystems;
-use crate::schedule::StepTotals;
+use crate::schedule::{StepTotals, StopRequest};
 use crate::segment::Segments;
 
 mod place;
 
-pub use place::place_circles;
+pub use place::{STOP_POLL_PLACED, place_circles, place_circles_until};
 use place::{hue_to_rgb, sample_between};
 
 /// Asks for all circles to be replaced by a fresh placement from the current [`SpawnConfig`]
@@ -39,6 +39,8 @@ pub struct SpawnReport {
     /// Why no random circles were placed, when the rules could not be followed (a compression
     /// that jammed, say).
     pub refused: Option<String>,
+    /// Whether a [`StopRequest`] ended the placement: no random circles were placed.
+    pub interrupted: bool,
 }
 
 /// Circles a scene places exactly, before the random ones.
@@ -85,26 +87,42 @@ impl Plugin for SpawnPlugin {
     }
 }
 
+/// What a placement reads, and the report it writes.
+#[derive(bevy::ecs::system::SystemParam)]
+struct Placing<'w> {
+    arena: Res<'w, Arena>,
+    config: Res<'w, SpawnConfig>,
+    fixed: Res<'w, FixedCircles>,
+    segments: Option<Res<'w, Segments>>,
+    report: ResMut<'w, SpawnReport>,
+    /// Asked while placing, so a signal does not wait for millions of circles.
+    stop: Option<Res<'w, StopRequest>>,
+}
+
 /// Spawns the [`FixedCircles`], then random circles placed from the [`SpawnConfig`] around them
 /// and clear of the [`Segments`].
-fn spawn_circles(
-    mut commands: Commands,
-    arena: Res<Arena>,
-    config: Res<SpawnConfig>,
-    around: (Res<FixedCircles>, Option<Res<Segments>>),
-    mut report: ResMut<SpawnReport>,
-) {
-    let (fixed, segments) = around;
+fn spawn_circles(mut commands: Commands, placing: Placing) {
+    let Placing {
+        arena,
+        config,
+        fixed,
+        segments,
+        mut report,
+        stop,
+    } = placing;
     let requested = config.target_count(&arena);
     let walls = segments.as_ref().map_or(&[][..], |s| &s.0[..]);
-    let (random, refused) = match place_circles(&arena, &config, &fixed.0, walls) {
+    let stopped = || stop.as_ref().is_some_and(|s| s.raised());
+    let (random, refused) = match place_circles_until(&arena, &config, &fixed.0, walls, stopped) {
         Ok(circles) => (circles, None),
         Err(e) => {
             error!("cannot spawn circles: {e}");
-            (Vec::new(), Some(e.to_string()))
+            (Some(Vec::new()), Some(e.to_string()))
         }
     };
-    if random.len() < requested {
+    let interrupted = random.is_none();
+    let random = random.unwrap_or_default();
+    if random.len() < requested && !interrupted {
         warn!(
             "placed {} of {requested} random circles: the arena has no room for more without overlap",
             random.len()
@@ -115,6 +133,7 @@ fn spawn_circles(
         placed: random.len() + fixed.0.len(),
         generation: report.generation + 1,
         refused,
+        interrupted,
     };
     let bundles: Vec<_> = fixed
         .0
@@ -184,14 +203,11 @@ fn respawn_circles(
     mut commands: Commands,
     mut requests: MessageReader<Respawn>,
     circles: Query<Entity, With<Radius>>,
-    arena: Res<Arena>,
-    config: Res<SpawnConfig>,
-    around: (Res<FixedCircles>, Option<Res<Segments>>),
-    report: ResMut<SpawnReport>,
+    placing: Placing,
 ) {
     requests.clear();
     for entity in &circles {
         commands.entity(entity).despawn();
     }
-    spawn_circles(commands, arena, config, around, report);
+    spawn_circles(commands, placing);
 }

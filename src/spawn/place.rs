@@ -42,6 +42,23 @@ pub fn place_circles(
     fixed: &[CircleState],
     segments: &[Segment],
 ) -> Result<Vec<CircleState>, FieldError> {
+    // Never stopped, so always some.
+    place_circles_until(arena, config, fixed, segments, || false).map(Option::unwrap_or_default)
+}
+
+/// Circles a placement tries between two looks at [`place_circles_until`]'s stop request.
+pub const STOP_POLL_PLACED: usize = 4096;
+
+/// [`place_circles`], asking `stop` every [`STOP_POLL_PLACED`] circles (and through a `pack`
+/// compression) whether to give up: `None` when it did. Millions of circles take seconds to
+/// place, which a signal must not wait for.
+pub fn place_circles_until(
+    arena: &Arena,
+    config: &SpawnConfig,
+    fixed: &[CircleState],
+    segments: &[Segment],
+    stop: impl Fn() -> bool,
+) -> Result<Option<Vec<CircleState>>, FieldError> {
     arena.check()?;
     config.check(arena).map_err(|e| e.within("spawn"))?;
     let (r_min, r_max) = config.radius;
@@ -50,10 +67,17 @@ pub fn place_circles(
     let count = config.target_count(arena);
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     // Largest first: big circles are the hard ones to fit once the arena fills up.
-    let mut radii: Vec<f64> = (0..count)
-        .map(|_| rng.random_range(r_min..=r_max))
-        .collect();
+    let mut radii: Vec<f64> = Vec::with_capacity(count);
+    for drawn in 0..count {
+        if drawn % STOP_POLL_PLACED == 0 && stop() {
+            return Ok(None);
+        }
+        radii.push(rng.random_range(r_min..=r_max));
+    }
     radii.sort_by(|a, b| b.total_cmp(a));
+    if stop() {
+        return Ok(None);
+    }
     // A compression places the circles shrunk by `loose` first, then grows them back.
     let loose = match config.placement {
         Placement::Pack => pack_start(arena, config, &radii, (fixed, segments))?,
@@ -85,7 +109,10 @@ pub fn place_circles(
     .into_iter();
     // The radii of the circles placed, in order.
     let mut drawn = Vec::with_capacity(count);
-    for grown in radii {
+    for (tried, grown) in radii.into_iter().enumerate() {
+        if tried % STOP_POLL_PLACED == 0 && stop() {
+            return Ok(None);
+        }
         let r = grown * loose;
         let lo = arena.min + DVec2::splat(r);
         let hi = arena.max - DVec2::splat(r);
@@ -122,7 +149,10 @@ pub fn place_circles(
     }
     let mut random = placed.split_off(fixed.len());
     if loose < 1.0 {
-        random = grow_back(arena, config, &random, &drawn, loose)?;
+        match grow_back(arena, config, (&random, &drawn, loose), &stop)? {
+            Some(grown) => random = grown,
+            None => return Ok(None),
+        }
     }
     // Spawn in row-major cell order, so circles near each other in space are near each other in
     // memory: the collision pass then walks its arrays mostly in order (at 1M circles this is the
@@ -131,7 +161,7 @@ pub fn place_circles(
         let (x, y) = grid.cell_of(c.position);
         (y, x)
     });
-    Ok(random)
+    Ok(Some(random))
 }
 
 /// The densest packing of equal disks in the plane covers this much of it (hexagonal, π/√12):
@@ -176,15 +206,14 @@ fn pack_start(
 
 /// The `loose` circles grown back to their `radii` by a compression, each keeping its speed in
 /// the direction the compression left it moving. A jammed compression is an error naming what
-/// was asked for and how far it got.
+/// was asked for and how far it got; `None` if `stop` ended it.
 fn grow_back(
     arena: &Arena,
     config: &SpawnConfig,
-    loose: &[CircleState],
-    radii: &[f64],
-    shrunk: f64,
-) -> Result<Vec<CircleState>, FieldError> {
-    let mut packed = compress(loose, arena, 1.0 / shrunk).map_err(|jam| {
+    (loose, radii, shrunk): (&[CircleState], &[f64], f64),
+    stop: impl Fn() -> bool,
+) -> Result<Option<Vec<CircleState>>, FieldError> {
+    let packed = compress(loose, arena, 1.0 / shrunk, stop).map_err(|jam| {
         let field = match config.area_fraction {
             Some(_) => "area_fraction",
             None => "count",
@@ -200,10 +229,12 @@ fn grow_back(
         .within("spawn")
     })?;
     // The radii drawn, not the shrunk ones grown back (which can differ by rounding).
-    for (c, &r) in packed.iter_mut().zip(radii) {
-        c.radius = r;
-    }
-    Ok(packed)
+    Ok(packed.map(|mut packed| {
+        for (c, &r) in packed.iter_mut().zip(radii) {
+            c.radius = r;
+        }
+        packed
+    }))
 }
 
 pub(super) fn sample_between(rng: &mut impl Rng, lo: f64, hi: f64) -> f64 {
@@ -299,6 +330,23 @@ mod tests {
                 "{size} with {count} circles: {} cells",
                 grid.len()
             );
+        }
+    }
+
+    #[test]
+    fn a_placement_asked_to_stop_places_nothing() {
+        for placement in [Placement::Random, Placement::Lattice, Placement::Pack] {
+            let config = SpawnConfig {
+                count: 3 * STOP_POLL_PLACED,
+                radius: (0.01, 0.01),
+                placement,
+                ..SpawnConfig::default()
+            };
+            let arena = Arena::default();
+            let stopped = place_circles_until(&arena, &config, &[], &[], || true).unwrap();
+            assert!(stopped.is_none(), "{placement:?}");
+            let never = place_circles_until(&arena, &config, &[], &[], || false).unwrap();
+            assert_eq!(never.unwrap().len(), 3 * STOP_POLL_PLACED, "{placement:?}");
         }
     }
 

@@ -54,7 +54,14 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             let (config, source) = configure(input, &options)?;
             let dt = config.dt;
             set_threads(options.threads);
-            let mut app = start(config, &source)?;
+            let Some(mut app) = start(config, &source, interrupts.stop_request())? else {
+                // Nothing was run: every output is left as it was.
+                let signal = interrupts.raised().unwrap_or_default();
+                say(format_args!(
+                    "interrupted by signal {signal} while placing circles; nothing written"
+                ));
+                return Ok(Finished::Interrupted { signal });
+            };
             let progress = Progress::start(app.world_mut());
             (app, progress, source, dt)
         }
@@ -72,16 +79,30 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     let mut failed: Vec<anyhow::Error> = Vec::new();
     let stopped = loop {
         let now = app.world().resource::<StepTotals>().steps;
-        let next = match (&options.checkpoint, options.every) {
+        // Where the next checkpoint is due, or the end.
+        let due = match (&options.checkpoint, options.every) {
             (Some(_), Some(every)) => until.min((now / every + 1).saturating_mul(every)),
             _ => until,
         };
+        // The first step alone, to say at once how long a run of slow steps will take.
+        let next = if now == first {
+            due.min(first + 1)
+        } else {
+            due
+        };
         let stop = || interrupts.raised().is_some();
+        let before = progress.stepping;
         let stopped = advance(&mut app, &mut progress, next, sampling, stop, |s| {
             bar.set_position(s.step - first)
         });
+        if now == first && !stopped {
+            say_if_slow(progress.stepping - before, until - first);
+        }
         if stopped || next >= until {
             break stopped;
+        }
+        if next < due {
+            continue;
         }
         if let Some(path) = &options.checkpoint
             && let Err(e) = write_checkpoint(&mut app, &source, &progress, path)
@@ -185,6 +206,34 @@ impl Interrupts {
     }
 }
 
+/// A first step slower than this is announced with what the whole run will take.
+const SLOW_STEP: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// Says, on standard error, what `steps` steps will take if the first took `first`, when that
+/// is slow ([`SLOW_STEP`]): a run of 5-second steps otherwise looks like a hang.
+fn say_if_slow(first: std::time::Duration, steps: u64) {
+    if let Some(notice) = slow_notice(first, steps) {
+        eprintln!("moving_circles: {notice}");
+    }
+}
+
+/// [`say_if_slow`]'s notice, if any.
+fn slow_notice(first: std::time::Duration, steps: u64) -> Option<String> {
+    if first < SLOW_STEP || steps < 2 {
+        return None;
+    }
+    let whole = first.as_secs_f64() * steps as f64;
+    let (amount, unit) = match whole {
+        s if s < 120.0 => (s, "s"),
+        s if s < 7200.0 => (s / 60.0, "min"),
+        s => (s / 3600.0, "h"),
+    };
+    Some(format!(
+        "the first step took {:.1} s; {steps} steps will take about {amount:.0} {unit}",
+        first.as_secs_f64()
+    ))
+}
+
 fn write_checkpoint(
     app: &mut App,
     source: &str,
@@ -210,4 +259,21 @@ fn print_summary(r: &Report) {
         r.escaped,
         r.non_finite
     ));
+}
+
+#[cfg(test)]
+mod tests {
+    use std::time::Duration;
+
+    use super::slow_notice;
+
+    #[test]
+    fn a_slow_first_step_is_announced_with_the_whole_run() {
+        assert_eq!(slow_notice(Duration::from_millis(999), 1000), None);
+        assert_eq!(slow_notice(Duration::from_secs(30), 1), None);
+        let notice = |secs, steps| slow_notice(Duration::from_secs(secs), steps).unwrap();
+        assert!(notice(2, 10).ends_with("10 steps will take about 20 s"));
+        assert!(notice(5, 100).ends_with("about 8 min"));
+        assert!(notice(5, 100_000).ends_with("about 139 h"));
+    }
 }

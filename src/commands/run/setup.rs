@@ -9,8 +9,9 @@ use super::options::{Input, Length, MAX_STEPS, RunOptions, SolverChoice};
 use crate::accuracy::auto::choose_solver;
 use crate::config::{CirclesConfig, Placement, Solver};
 use crate::io::{check_output_path, same_output};
-use crate::run::headless_app;
+use crate::run::headless_app_with;
 use crate::scene::{Scene, particles};
+use crate::schedule::StopRequest;
 use crate::spawn::SpawnReport;
 
 /// Circles above which `run` says it is placing them before it starts (placing millions takes
@@ -70,8 +71,12 @@ pub(super) fn set_threads(threads: Option<u16>) {
 }
 
 /// The headless app of `config` from `source`, its circles placed (saying so first when that
-/// takes a while, and afterwards when not all fit).
-pub(super) fn start(config: CirclesConfig, source: &str) -> anyhow::Result<App> {
+/// takes a while, and afterwards when not all fit); `None` if `stop` was raised while placing.
+pub(super) fn start(
+    config: CirclesConfig,
+    source: &str,
+    stop: StopRequest,
+) -> anyhow::Result<Option<App>> {
     let placing = config.spawn.target_count(&config.arena);
     let how = match config.spawn.placement {
         Placement::Pack => "compressing",
@@ -85,8 +90,13 @@ pub(super) fn start(config: CirclesConfig, source: &str) -> anyhow::Result<App> 
     if placing >= announce_from {
         eprintln!("moving_circles: {how} {placing} circles (this takes a while)");
     }
-    let app = headless_app(config);
+    let app = headless_app_with(config, |app| {
+        app.insert_resource(stop);
+    });
     let spawn = app.world().resource::<SpawnReport>();
+    if spawn.interrupted {
+        return Ok(None);
+    }
     if let Some(refused) = &spawn.refused {
         bail!("{source}: cannot spawn the scene's circles: {refused}");
     }
@@ -96,7 +106,7 @@ pub(super) fn start(config: CirclesConfig, source: &str) -> anyhow::Result<App> 
             spawn.placed, spawn.requested
         );
     }
-    Ok(app)
+    Ok(Some(app))
 }
 
 /// Refuses, before any work, outputs that could not be written or would clobber something:

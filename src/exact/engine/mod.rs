@@ -20,6 +20,7 @@
 //! grow as the circles fly (`growth`). Under gravity, circles at rest on a support sleep and
 //! are woken by a hard hit (`rest`). Everything is f64.
 
+mod build;
 mod events;
 mod growth;
 mod large;
@@ -33,15 +34,14 @@ mod walls;
 pub use events::{BudgetExhausted, EventStats, Rest};
 pub use snapshot::EngineSnapshot;
 
-use events::{BestPair, Event, Kind, Motion, NO_PAIR};
+use events::{BestPair, Event, Kind, Motion};
 use walls::{Layout, cell_width, walls_inside};
 
 use bevy::math::DVec2;
 
 use super::queue::EventQueue;
 use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::grid::{CellMembers, Grid, NONE};
+use crate::grid::{CellMembers, Grid};
 use crate::hits::HitLog;
 use crate::segment::{Segment, SegmentCells};
 
@@ -116,146 +116,6 @@ pub struct EventEngine {
 }
 
 impl EventEngine {
-    /// Builds the engine at time 0 and predicts every circle's first event. Circles must have
-    /// finite state; with walls their centres must lie within `[min + r, max - r]` (a centre
-    /// just outside by rounding is treated as touching the wall) and clear of the `segments`
-    /// (ignored on a periodic arena).
-    pub fn new(
-        circles: &[CircleState],
-        arena: &Arena,
-        segments: &[Segment],
-        restitution: f64,
-        wall_restitution: f64,
-    ) -> Self {
-        let width = cell_width(arena, circles);
-        Self::with_cells(
-            circles,
-            arena,
-            segments,
-            (restitution, wall_restitution),
-            width,
-        )
-    }
-
-    /// [`EventEngine::new`] under `gravity`: movable circles fly parabolas, and each starts with
-    /// its [`Rest`] in `rest` (one per circle, or none: all awake, not at rest). A circle whose bounce on a support
-    /// (a wall, a segment wall, an immovable or sleeping circle) dies down falls asleep; a
-    /// sleeping circle wakes when hit hard, or when [`EventEngine::set_motion`] moves it.
-    pub fn falling(
-        circles: &[CircleState],
-        arena: &Arena,
-        segments: &[Segment],
-        (restitution, wall_restitution): (f64, f64),
-        gravity: DVec2,
-        rest: &[Rest],
-    ) -> Self {
-        let width = cell_width(arena, circles);
-        let mut engine = Self::lay_out(
-            circles,
-            arena,
-            segments,
-            (restitution, wall_restitution),
-            width,
-        );
-        engine.gravity = gravity;
-        for i in 0..engine.len() {
-            let at_rest = rest.get(i).copied().unwrap_or_default();
-            engine.asleep[i] = at_rest.asleep;
-            engine.anchor[i] = (at_rest.anchor, -at_rest.resting_for);
-            if engine.asleep[i] {
-                engine.motion[i].vel = DVec2::ZERO;
-            }
-            engine.falls[i] = engine.can_fall(i);
-        }
-        engine.relink_all();
-        engine.predict_all();
-        engine
-    }
-
-    /// [`EventEngine::new`] on cells at least `width` wide (and a largest diameter).
-    fn with_cells(
-        circles: &[CircleState],
-        arena: &Arena,
-        segments: &[Segment],
-        restitutions: (f64, f64),
-        width: f64,
-    ) -> Self {
-        let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
-        engine.relink_all();
-        engine.predict_all();
-        engine
-    }
-
-    /// The engine's state for `circles` at time 0, before any circle is put in a cell or
-    /// predicted.
-    fn lay_out(
-        circles: &[CircleState],
-        arena: &Arena,
-        segments: &[Segment],
-        (restitution, wall_restitution): (f64, f64),
-        width: f64,
-    ) -> Self {
-        let n = circles.len();
-        let size = arena.size();
-        let Layout {
-            grid,
-            segments,
-            segment_cells,
-            large,
-            reach,
-        } = walls_inside(arena, circles, segments, width);
-        Self {
-            arena: *arena,
-            period: size,
-            restitution,
-            wall_restitution,
-            now: 0.0,
-            motion: circles
-                .iter()
-                .map(|c| Motion {
-                    pos: if arena.is_periodic() {
-                        arena.wrap(c.position)
-                    } else {
-                        c.position
-                    },
-                    vel: c.velocity,
-                    t_at: 0.0,
-                    radius: c.radius,
-                })
-                .collect(),
-            inv_mass: circles.iter().map(CircleState::inv_mass).collect(),
-            counter: vec![0; n],
-            event: vec![
-                Event {
-                    kind: Kind::Idle,
-                    partner: NONE,
-                    partner_count: 0
-                };
-                n
-            ],
-            best_pair: vec![NO_PAIR; n],
-            queue: EventQueue::new(n),
-            cells: CellMembers::new(grid.len(), n),
-            grid,
-            cell_x: vec![0; n],
-            cell_y: vec![0; n],
-            stats: EventStats::default(),
-            segments,
-            segment_cells,
-            own_restitution: Vec::new(),
-            hits: None,
-            growth: 0.0,
-            large,
-            reach,
-            gravity: DVec2::ZERO,
-            falls: vec![false; n],
-            asleep: vec![false; n],
-            last_hit: vec![f64::NEG_INFINITY; n],
-            quick_hits: vec![0; n],
-            anchor: vec![(DVec2::INFINITY, 0.0); n],
-        }
-    }
-
     /// Gives each circle its own restitution (one value per circle, in order; empty: all take
     /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`](crate::collide::contact::combine_restitution).
     pub fn set_own_restitutions(&mut self, restitutions: Vec<f64>) {

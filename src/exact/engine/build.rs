@@ -1,0 +1,231 @@
+//! Building an engine from circles: the cells laid out over the arena (and the few large
+//! circles kept out of them), every circle put in its cell, and every circle's first event
+//! predicted, in one go or asking between predictions whether to give up.
+
+use bevy::math::DVec2;
+
+use super::EventEngine;
+use super::events::{Event, EventStats, Kind, Motion, NO_PAIR, Rest};
+use super::walls::{Layout, cell_width, walls_inside};
+use crate::arena::Arena;
+use crate::circle::CircleState;
+use crate::exact::queue::EventQueue;
+use crate::grid::{CellMembers, NONE};
+use crate::segment::Segment;
+
+/// Predictions between two looks at [`EventEngine::build_until`]'s stop request: a few
+/// milliseconds of work.
+pub const STOP_POLL_CIRCLES: usize = 16_384;
+
+impl EventEngine {
+    /// Builds the engine at time 0 and predicts every circle's first event. Circles must have
+    /// finite state; with walls their centres must lie within `[min + r, max - r]` (a centre
+    /// just outside by rounding is treated as touching the wall) and clear of the `segments`
+    /// (ignored on a periodic arena).
+    pub fn new(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        restitution: f64,
+        wall_restitution: f64,
+    ) -> Self {
+        let width = cell_width(arena, circles);
+        Self::with_cells(
+            circles,
+            arena,
+            segments,
+            (restitution, wall_restitution),
+            width,
+        )
+    }
+
+    /// [`EventEngine::new`] under `gravity`: movable circles fly parabolas, and each starts with
+    /// its [`Rest`] in `rest` (one per circle, or none: all awake, not at rest). A circle whose bounce on a support
+    /// (a wall, a segment wall, an immovable or sleeping circle) dies down falls asleep; a
+    /// sleeping circle wakes when hit hard, or when [`EventEngine::set_motion`] moves it.
+    pub fn falling(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        restitutions: (f64, f64),
+        gravity: DVec2,
+        rest: &[Rest],
+    ) -> Self {
+        let mut engine =
+            Self::placed_falling(circles, arena, segments, restitutions, gravity, rest);
+        engine.predict_all();
+        engine
+    }
+
+    /// [`EventEngine::new`], or [`EventEngine::falling`] under `gravity`, asking `stop` every
+    /// [`STOP_POLL_CIRCLES`] predictions whether to give up: `None` when it did. A build of
+    /// millions of circles takes seconds, which a signal must not wait for.
+    pub fn build_until(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        restitutions: (f64, f64),
+        (gravity, rest): (Option<DVec2>, &[Rest]),
+        stop: impl Fn() -> bool,
+    ) -> Option<Self> {
+        let mut engine = match gravity {
+            Some(g) => Self::placed_falling(circles, arena, segments, restitutions, g, rest),
+            None => {
+                let width = cell_width(arena, circles);
+                let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
+                engine.relink_all();
+                engine
+            }
+        };
+        for i in 0..engine.len() {
+            if i % STOP_POLL_CIRCLES == 0 && stop() {
+                return None;
+            }
+            engine.predict(i);
+        }
+        Some(engine)
+    }
+
+    /// [`EventEngine::falling`] before any prediction: every circle in its cell.
+    fn placed_falling(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        restitutions: (f64, f64),
+        gravity: DVec2,
+        rest: &[Rest],
+    ) -> Self {
+        let width = cell_width(arena, circles);
+        let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
+        engine.gravity = gravity;
+        for i in 0..engine.len() {
+            let at_rest = rest.get(i).copied().unwrap_or_default();
+            engine.asleep[i] = at_rest.asleep;
+            engine.anchor[i] = (at_rest.anchor, -at_rest.resting_for);
+            if engine.asleep[i] {
+                engine.motion[i].vel = DVec2::ZERO;
+            }
+            engine.falls[i] = engine.can_fall(i);
+        }
+        engine.relink_all();
+        engine
+    }
+
+    /// [`EventEngine::new`] on cells at least `width` wide (and a largest diameter).
+    pub(super) fn with_cells(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        restitutions: (f64, f64),
+        width: f64,
+    ) -> Self {
+        let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
+        engine.relink_all();
+        engine.predict_all();
+        engine
+    }
+
+    /// The engine's state for `circles` at time 0, before any circle is put in a cell or
+    /// predicted.
+    fn lay_out(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        (restitution, wall_restitution): (f64, f64),
+        width: f64,
+    ) -> Self {
+        let n = circles.len();
+        let size = arena.size();
+        let Layout {
+            grid,
+            segments,
+            segment_cells,
+            large,
+            reach,
+        } = walls_inside(arena, circles, segments, width);
+        Self {
+            arena: *arena,
+            period: size,
+            restitution,
+            wall_restitution,
+            now: 0.0,
+            motion: circles
+                .iter()
+                .map(|c| Motion {
+                    pos: if arena.is_periodic() {
+                        arena.wrap(c.position)
+                    } else {
+                        c.position
+                    },
+                    vel: c.velocity,
+                    t_at: 0.0,
+                    radius: c.radius,
+                })
+                .collect(),
+            inv_mass: circles.iter().map(CircleState::inv_mass).collect(),
+            counter: vec![0; n],
+            event: vec![
+                Event {
+                    kind: Kind::Idle,
+                    partner: NONE,
+                    partner_count: 0
+                };
+                n
+            ],
+            best_pair: vec![NO_PAIR; n],
+            queue: EventQueue::new(n),
+            cells: CellMembers::new(grid.len(), n),
+            grid,
+            cell_x: vec![0; n],
+            cell_y: vec![0; n],
+            stats: EventStats::default(),
+            segments,
+            segment_cells,
+            own_restitution: Vec::new(),
+            hits: None,
+            growth: 0.0,
+            large,
+            reach,
+            gravity: DVec2::ZERO,
+            falls: vec![false; n],
+            asleep: vec![false; n],
+            last_hit: vec![f64::NEG_INFINITY; n],
+            quick_hits: vec![0; n],
+            anchor: vec![(DVec2::INFINITY, 0.0); n],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    use super::*;
+    use crate::arena::Boundary;
+
+    #[test]
+    fn a_build_asked_to_stop_gives_up_and_one_never_asked_is_the_whole_build() {
+        let arena = Arena::unit_square(Boundary::Walls);
+        let circles: Vec<CircleState> = (0..40_000)
+            .map(|i| {
+                let (x, y) = ((i % 200) as f64 + 0.5, (i / 200) as f64 + 0.5);
+                let v = DVec2::new((i * 7 % 5) as f64 - 2.0, (i * 3 % 7) as f64 - 3.0);
+                CircleState::new(DVec2::new(x, y) / 200.0 - 0.5, v * 0.01, 0.001)
+            })
+            .collect();
+        let (restitutions, fall) = ((1.0, 1.0), (None, &[][..]));
+        // Asked once per STOP_POLL_CIRCLES predictions, and told to stop the second time.
+        let asked = Cell::new(0);
+        let stop = || {
+            asked.set(asked.get() + 1);
+            asked.get() == 2
+        };
+        assert!(
+            EventEngine::build_until(&circles, &arena, &[], restitutions, fall, stop).is_none()
+        );
+        assert_eq!(asked.get(), 2);
+        let whole = EventEngine::build_until(&circles, &arena, &[], restitutions, fall, || false);
+        let new = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
+        assert_eq!(whole.map(|e| e.snapshot()), Some(new.snapshot()));
+    }
+}
