@@ -31,6 +31,7 @@ mod rest;
 mod snapshot;
 mod walls;
 
+pub use build::STOP_POLL_CIRCLES;
 pub use events::{BudgetExhausted, EventStats, Rest};
 pub use snapshot::EngineSnapshot;
 
