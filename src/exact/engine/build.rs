@@ -70,20 +70,15 @@ impl EventEngine {
     ) -> Option<Self> {
         let mut engine = match gravity {
             Some(g) => Self::placed_falling(circles, arena, segments, restitutions, g, rest),
-            None => {
-                let width = cell_width(arena, circles);
-                let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
-                engine.relink_all();
-                engine
-            }
+            None => Self::placed(
+                circles,
+                arena,
+                segments,
+                restitutions,
+                cell_width(arena, circles),
+            ),
         };
-        for i in 0..engine.len() {
-            if i % STOP_POLL_CIRCLES == 0 && stop() {
-                return None;
-            }
-            engine.predict(i);
-        }
-        Some(engine)
+        engine.predict_all_until(stop).then_some(engine)
     }
 
     /// [`EventEngine::falling`] before any prediction: every circle in its cell.
@@ -119,9 +114,21 @@ impl EventEngine {
         restitutions: (f64, f64),
         width: f64,
     ) -> Self {
+        let mut engine = Self::placed(circles, arena, segments, restitutions, width);
+        engine.predict_all();
+        engine
+    }
+
+    /// [`EventEngine::with_cells`] before any prediction: every circle in its cell.
+    fn placed(
+        circles: &[CircleState],
+        arena: &Arena,
+        segments: &[Segment],
+        restitutions: (f64, f64),
+        width: f64,
+    ) -> Self {
         let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
         engine.relink_all();
-        engine.predict_all();
         engine
     }
 

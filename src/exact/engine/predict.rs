@@ -321,9 +321,20 @@ impl EventEngine {
     }
 
     pub(super) fn predict_all(&mut self) {
+        self.predict_all_until(|| false);
+    }
+
+    /// [`EventEngine::predict_all`], asking `stop` every
+    /// [`STOP_POLL_CIRCLES`](super::STOP_POLL_CIRCLES) circles whether to give up; whether it
+    /// predicted them all.
+    pub(super) fn predict_all_until(&mut self, stop: impl Fn() -> bool) -> bool {
         for i in 0..self.len() {
+            if i % super::STOP_POLL_CIRCLES == 0 && stop() {
+                return false;
+            }
             self.predict(i);
         }
+        true
     }
 }
 
