@@ -1,6 +1,7 @@
-//! The region the circles live in: [`Arena`], a rectangle whose edges are walls or periodic
-//! ([`Boundary`]), and the geometry every solver reads from it: containment, the displacement
-//! between two points (the minimum image on a periodic arena) and wrapping back inside.
+//! The region the circles live in: [`Arena`], a rectangle whose edges are walls, periodic or
+//! open ([`Boundary`]), and the geometry every solver reads from it: containment, the
+//! displacement between two points (the minimum image on a periodic arena) and wrapping back
+//! inside.
 
 use std::fmt;
 use std::str::FromStr;
@@ -22,6 +23,11 @@ pub enum Boundary {
     /// Periodic: a circle leaving one side enters at the opposite one, and circles interact
     /// across the seam (minimum image).
     Periodic,
+    /// No edges: circles fly out of the rectangle and on, and meet wherever they are. Walls, if
+    /// any, come from segment walls and immovable circles. The rectangle is where the circles
+    /// are placed and what the grids cover: circles far outside it share the edge cells, correct
+    /// but slower, so it should hold where the circles mostly are.
+    Open,
 }
 
 impl fmt::Display for Boundary {
@@ -29,6 +35,7 @@ impl fmt::Display for Boundary {
         f.write_str(match self {
             Self::Walls => "walls",
             Self::Periodic => "periodic",
+            Self::Open => "open",
         })
     }
 }
@@ -40,8 +47,9 @@ impl FromStr for Boundary {
         match s {
             "walls" => Ok(Self::Walls),
             "periodic" => Ok(Self::Periodic),
+            "open" => Ok(Self::Open),
             other => Err(format!(
-                "unknown boundary `{other}`: expected `walls` or `periodic`"
+                "unknown boundary `{other}`: expected `walls`, `periodic` or `open`"
             )),
         }
     }
@@ -66,7 +74,7 @@ pub struct Arena {
     pub min: DVec2,
     /// Upper-right corner.
     pub max: DVec2,
-    /// Walls or periodic edges.
+    /// Walls, periodic edges or none.
     #[serde(default)]
     pub boundary: Boundary,
 }
@@ -108,6 +116,12 @@ impl Arena {
         self.boundary == Boundary::Periodic
     }
 
+    /// Whether the edges are walls that circles bounce off (and stay within).
+    #[inline]
+    pub fn has_walls(&self) -> bool {
+        self.boundary == Boundary::Walls
+    }
+
     /// Width and height.
     #[inline]
     pub fn size(&self) -> DVec2 {
@@ -141,7 +155,7 @@ impl Arena {
     #[inline]
     pub fn offset(&self, a: DVec2, b: DVec2) -> DVec2 {
         match self.boundary {
-            Boundary::Walls => b - a,
+            Boundary::Walls | Boundary::Open => b - a,
             Boundary::Periodic => minimum_image(b - a, self.size()),
         }
     }

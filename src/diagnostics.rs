@@ -7,7 +7,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
+use crate::arena::{Arena, Boundary};
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
 use crate::components::{Mass, Position, Radius, Velocity};
@@ -47,7 +47,8 @@ impl Pressure {
         let perimeter = 2.0 * (size.x + size.y);
         Self {
             z_virial: Some(z_virial),
-            z_wall: (!arena.is_periodic())
+            z_wall: arena
+                .has_walls()
                 .then(|| walls.impulse / (t * perimeter) * area / n_kt)
                 .filter(|z| z.is_finite()),
         }
@@ -147,7 +148,8 @@ impl Totals {
                 totals.non_finite += 1;
                 continue;
             }
-            totals.escaped += usize::from(!arena.contains(p));
+            // An open arena has no edge to escape by.
+            totals.escaped += usize::from(arena.boundary != Boundary::Open && !arena.contains(p));
             if !m.is_finite() {
                 continue;
             }

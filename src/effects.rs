@@ -52,12 +52,12 @@ impl Effect {
     ];
 
     /// Whether `effects` on an arena with this `boundary` and these `segments` calls for this
-    /// effect (segment walls need an arena with walls).
+    /// effect (segment walls need an arena that is not periodic).
     pub fn is_called_for(self, effects: &Effects, boundary: Boundary, segments: &Segments) -> bool {
         match self {
             Effect::Gravity => effects.gravity.is_some(),
             Effect::Drag => effects.drag.is_some(),
-            Effect::Segments => boundary == Boundary::Walls && !segments.is_empty(),
+            Effect::Segments => boundary != Boundary::Periodic && !segments.is_empty(),
             Effect::Walls => boundary == Boundary::Walls,
             Effect::Periodic => boundary == Boundary::Periodic,
             Effect::Collisions => effects.collisions,

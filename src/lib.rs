@@ -37,7 +37,6 @@
 //! use moving_circles::prelude::*;
 //!
 //! let mut app = moving_circles::run::headless_app(CirclesConfig {
-//!     spawn: SpawnConfig { count: 0, ..default() },
 //!     effects: Effects { hit_messages: true, ..default() },
 //!     solver: Solver::Exact,
 //!     ..default()

@@ -125,7 +125,7 @@ struct RunArgs {
     /// against `exact` after a short calibration and the deepest overlap, both in radii.
     #[arg(long)]
     tolerance: Option<f64>,
-    /// Boundary of a particle file's unit square: `walls` or `periodic`.
+    /// Boundary of a particle file's unit square: `walls`, `periodic` or `open`.
     #[arg(long)]
     boundary: Option<Boundary>,
     /// Fixed step in seconds, e.g. `0.01` or `1/60` (default: the scene's, or 1/60).

@@ -123,7 +123,7 @@ impl Segments {
     }
 
     /// Whether these segments fit `arena`: no more than [`MAX_SEGMENTS`], every end inside it,
-    /// and an arena with walls (on a periodic one a segment would have to wrap). Fields are
+    /// and an arena that is not periodic (there a segment would have to wrap). Fields are
     /// named `segments[k].a` / `.b`, `k` counting segments as a [`WallHit`] does.
     ///
     /// [`WallHit`]: crate::hits::WallHit
@@ -134,7 +134,7 @@ impl Segments {
             return Err(FieldError::new("segments", why));
         }
         if !self.is_empty() && arena.is_periodic() {
-            let why = "segment walls need an arena with walls, not a periodic one";
+            let why = "segment walls need an arena with walls or an open one, not a periodic one";
             return Err(FieldError::new("segments", why));
         }
         for (k, s) in self.0.iter().enumerate() {

@@ -15,7 +15,7 @@ use moving_circles::run::headless_app_with;
 
 /// The classic scene with the app's input and HUD plugins, past its first update.
 fn app() -> App {
-    headless_app_with(CirclesConfig::default(), |app| {
+    headless_app_with(moving_circles::scene::classic(), |app| {
         app.init_resource::<ButtonInput<KeyCode>>()
             .init_resource::<ButtonInput<MouseButton>>()
             .add_plugins((InputPlugin, HudPlugin));
@@ -52,7 +52,7 @@ fn r_respawns_from_the_same_seed() {
     app.update(); // the respawn runs in the next frame's PreUpdate
     assert_eq!(generation(&app), spawned + 1, "one respawn");
     assert_eq!(steps(&app), 1, "counters restart at the respawn");
-    let mut fresh = headless_app_with(CirclesConfig::default(), |_| {});
+    let mut fresh = headless_app_with(moving_circles::scene::classic(), |_| {});
     fresh.update();
     assert_eq!(
         circles(&mut app),

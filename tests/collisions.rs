@@ -10,7 +10,7 @@ use moving_circles::prelude::*;
 
 #[test]
 fn a_head_on_equal_mass_hit_swaps_velocities() {
-    let mut app = create_app(empty(CirclesConfig::default()));
+    let mut app = create_app(CirclesConfig::default());
     let a = spawn_circle(
         &mut app,
         DVec2::new(-2.0, 0.0),
@@ -38,7 +38,7 @@ fn a_head_on_equal_mass_hit_swaps_velocities() {
 
 #[test]
 fn an_oblique_hit_of_unequal_masses_conserves_momentum_and_energy() {
-    let mut app = create_app(empty(CirclesConfig::default()));
+    let mut app = create_app(CirclesConfig::default());
     spawn_circle(
         &mut app,
         DVec2::new(-2.0, 0.3),
@@ -76,7 +76,7 @@ fn an_oblique_hit_of_unequal_masses_conserves_momentum_and_energy() {
 
 #[test]
 fn coincident_centres_never_produce_nan() {
-    let mut app = create_app(empty(CirclesConfig::default()));
+    let mut app = create_app(CirclesConfig::default());
     spawn_circle(&mut app, DVec2::new(1.0, 1.0), DVec2::ZERO, 0.5, 1.0);
     spawn_circle(&mut app, DVec2::new(1.0, 1.0), DVec2::ZERO, 0.5, 1.0);
     spawn_circle(

@@ -32,7 +32,7 @@ fn a_lattice_fills_area_fraction_0_85_with_no_overlap() {
         for c in &circles {
             let inside = match boundary {
                 Boundary::Periodic => config.arena.contains(c.position),
-                Boundary::Walls => {
+                Boundary::Walls | Boundary::Open => {
                     let r = DVec2::splat(c.radius);
                     let (lo, hi) = (config.arena.min + r, config.arena.max - r);
                     c.position.cmpge(lo).all() && c.position.cmple(hi).all()

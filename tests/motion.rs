@@ -10,7 +10,7 @@ use moving_circles::schedule::StepDt;
 
 #[test]
 fn a_lone_circle_moves_exactly_v_dt_per_step() {
-    let mut app = create_app(empty(CirclesConfig::default()));
+    let mut app = create_app(CirclesConfig::default());
     let v = DVec2::new(1.25, -0.5);
     let circle = spawn_circle(&mut app, DVec2::new(-1.0, 0.5), v, 0.3, 1.0);
     let mut expected = DVec2::new(-1.0, 0.5);
@@ -30,7 +30,7 @@ fn a_lone_circle_moves_exactly_v_dt_per_step() {
 fn substeps_cover_the_same_time() {
     let config = CirclesConfig {
         solver: Solver::Substeps(4),
-        ..empty(CirclesConfig::default())
+        ..CirclesConfig::default()
     };
     let mut app = create_app(config);
     let circle = spawn_circle(&mut app, DVec2::ZERO, DVec2::new(2.0, 0.0), 0.3, 1.0);
@@ -47,7 +47,7 @@ fn substeps_cover_the_same_time() {
 #[test]
 fn a_wall_hit_reflects_and_stays_inside() {
     let arena = Arena::default();
-    let mut app = create_app(empty(CirclesConfig::default()));
+    let mut app = create_app(CirclesConfig::default());
     let r = 0.4;
     let v = DVec2::new(6.0, 1.5);
     let circle = spawn_circle(&mut app, DVec2::new(arena.max.x - 1.0, 0.0), v, r, 1.0);

@@ -48,7 +48,7 @@ fn the_schedule_has_no_ambiguities() {
 
 #[test]
 fn the_default_schedule_runs_the_four_systems_of_the_seed_in_order() {
-    let mut app = create_app(CirclesConfig::default());
+    let mut app = create_app(moving_circles::scene::classic());
     let step: Vec<_> = scheduled_systems(&mut app)
         .into_iter()
         .filter(|(schedule, _)| schedule == "CircleStep")
@@ -82,13 +82,13 @@ fn without_collisions_there_is_no_collision_system() {
         "{names:#?}"
     );
     // And the circles really pass through each other.
-    let mut app = create_app(empty(CirclesConfig {
+    let mut app = create_app(CirclesConfig {
         effects: Effects {
             collisions: false,
             ..default()
         },
         ..default()
-    }));
+    });
     spawn_head_on(&mut app, 1.0, 1.0, 0.5);
     step(&mut app, 120);
     let xs: Vec<f64> = circles(&mut app).iter().map(|c| c.0.x).collect();

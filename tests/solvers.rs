@@ -59,10 +59,10 @@ fn swept_conserves_energy_to_1e6_over_100_seconds_of_a_1000_circle_gas() {
 
 /// Two circles of radius 0.01 closing at 8 diameters per step (0.16 per step at 60 Hz).
 fn fast_pair(solver: Solver) -> (u64, Vec<(DVec2, DVec2, f64, f64)>) {
-    let mut app = create_app(empty(CirclesConfig {
+    let mut app = create_app(CirclesConfig {
         solver,
         ..default()
-    }));
+    });
     spawn_head_on(&mut app, 1.0, 4.8, 0.01);
     step(&mut app, 20);
     (pair_collisions(&app), circles(&mut app))

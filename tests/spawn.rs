@@ -75,13 +75,14 @@ fn an_overfull_request_places_what_fits_and_reports_it() {
 #[test]
 fn the_same_seed_places_the_same_circles_and_another_seed_does_not() {
     let arena = Arena::default();
-    let a = place_circles(&arena, &SpawnConfig::default(), &[], &[]).unwrap();
-    let b = place_circles(&arena, &SpawnConfig::default(), &[], &[]).unwrap();
+    let spawn = moving_circles::scene::classic().spawn;
+    let a = place_circles(&arena, &spawn, &[], &[]).unwrap();
+    let b = place_circles(&arena, &spawn, &[], &[]).unwrap();
     let c = place_circles(
         &arena,
         &SpawnConfig {
             seed: 2,
-            ..default()
+            ..spawn.clone()
         },
         &[],
         &[],
@@ -123,7 +124,7 @@ fn the_same_seed_gives_the_same_state_after_600_steps() {
 
 #[test]
 fn a_respawn_replaces_every_circle() {
-    let mut app = create_app(CirclesConfig::default());
+    let mut app = create_app(moving_circles::scene::classic());
     step(&mut app, 10);
     app.world_mut().resource_mut::<SpawnConfig>().count = 7;
     app.world_mut().write_message(Respawn);

@@ -172,7 +172,7 @@ pub fn resolve_all_contacts(
     for &(k, l) in pairs.iter() {
         for k in [k as usize, l as usize] {
             let (position, radius) = &mut sorted[k];
-            if !arena.is_periodic() && !arena.contains(*position) {
+            if arena.has_walls() && !arena.contains(*position) {
                 put_back_inside(position, *radius, arena);
             }
             discs[order[k] as usize].0 = *position;
@@ -197,7 +197,7 @@ pub fn separate_overlaps(circles: &mut [CircleState], arena: &Arena) {
             let mut p = scratch.position(i);
             if arena.is_periodic() {
                 p = arena.wrap(p);
-            } else {
+            } else if arena.has_walls() {
                 put_back_inside(&mut p, c.radius, arena);
             }
             c.position = p;

@@ -170,7 +170,9 @@ pub struct CirclesConfig {
 }
 
 impl Default for CirclesConfig {
-    /// The seed: a 16:9 arena with 32 random circles, stepped at 60 Hz.
+    /// Nothing spawned, in a 16:9 arena with walls, stepped at 60 Hz with the `discrete` solver:
+    /// what the plugin group starts from when a game asks for nothing. The app and the command
+    /// line start from the classic scene instead ([`scene::classic`](crate::scene::classic)).
     fn default() -> Self {
         Self {
             arena: Arena::default(),

@@ -78,7 +78,7 @@ impl MassModel {
 #[reflect(Resource, Debug)]
 #[serde(default, deny_unknown_fields)]
 pub struct SpawnConfig {
-    /// How many circles to place (ignored when `area_fraction` is set).
+    /// How many circles to place (ignored when `area_fraction` is set); none by default.
     pub count: usize,
     /// Fill this fraction of the arena's area instead of placing `count` circles.
     pub area_fraction: Option<f64>,
@@ -133,10 +133,11 @@ impl FromStr for Placement {
 }
 
 impl Default for SpawnConfig {
-    /// The seed exercise: 32 circles of random radius, speed and direction.
+    /// No circles: the radii, speeds and seed of the course's exercise, for a `count` or an
+    /// `area_fraction` to place (the classic scene places 32).
     fn default() -> Self {
         Self {
-            count: 32,
+            count: 0,
             area_fraction: None,
             radius: (0.2, 0.6),
             speed: (1.0, 4.0),

@@ -10,7 +10,7 @@ use std::path::Path;
 use bevy::math::DVec2;
 
 use super::schema::Scene;
-use crate::arena::Arena;
+use crate::arena::{Arena, Boundary};
 use crate::circle::{CircleState, discs};
 use crate::collide::broad_phase::visit_overlapping_pairs;
 use crate::collide::pass::separate_overlaps;
@@ -171,7 +171,7 @@ fn polyline_of(polylines: &[Vec<DVec2>], mut k: usize) -> (usize, usize) {
 
 /// Checks one explicit circle: finite, positive radius, a mass in range or infinite (a static
 /// circle, which must be at rest), inside the arena (entirely, with walls; its centre, when
-/// periodic), not larger than it.
+/// periodic; anywhere, when open), not larger than it.
 pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
     check_vector("position", c.position)?;
     check_vector("velocity", c.velocity)?;
@@ -211,6 +211,9 @@ pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
                 c.radius, size.x, size.y
             ),
         ));
+    }
+    if arena.boundary == Boundary::Open {
+        return Ok(()); // no edge to be inside of: anywhere in range
     }
     let slack = rounding_slack(c.position, c.radius);
     let (lo, hi) = if arena.is_periodic() {

@@ -18,7 +18,7 @@ pub struct ArenaSpec {
     pub size: DVec2,
     /// Centre.
     pub center: DVec2,
-    /// `walls` or `periodic`.
+    /// `walls`, `periodic` or `open` (no edges).
     pub boundary: Boundary,
 }
 
@@ -83,7 +83,7 @@ pub struct Scene {
     /// Circles dropped in one at a time while it runs, if any.
     pub drop: Option<DropConfig>,
     /// Segment walls, as polylines: each is a list of two or more points inside the arena,
-    /// joined in order (two points: one segment). Only on an arena with walls.
+    /// joined in order (two points: one segment). Not on a periodic arena.
     pub segments: Vec<Vec<DVec2>>,
     /// Push apart explicit circles that overlap instead of rejecting the scene.
     pub separate_overlaps: bool,

@@ -149,13 +149,15 @@ pub fn find_contacts(
     if arena.is_periodic() {
         return;
     }
+    // Arena walls if it has them; segment walls also in an open arena.
+    let axes = if arena.has_walls() { 0..2 } else { 0..0 };
     for i in 0..bodies.len() {
         if bodies.inv_mass[i] == 0.0 {
             continue; // immovable circles are kept inside by whoever steers them
         }
         let (p, r) = (bodies.position[i], bodies.radius[i]);
         let limit = r * SPECULATIVE_MARGIN + travel(i);
-        for axis in 0..2 {
+        for axis in axes.clone() {
             for high in [false, true] {
                 let wall = ArenaWall::on_axis(axis, high);
                 let (anchor, normal) = wall.contact(p, arena);

@@ -16,17 +16,6 @@ pub fn create_app(config: CirclesConfig) -> App {
     moving_circles::run::headless_app(config)
 }
 
-/// A config with no random circles, so a test can place its own.
-pub fn empty(config: CirclesConfig) -> CirclesConfig {
-    CirclesConfig {
-        spawn: SpawnConfig {
-            count: 0,
-            ..config.spawn
-        },
-        ..config
-    }
-}
-
 /// A unit box asked for `fraction` of circles of radii `radius` at speed 1, placed by
 /// `placement`, run by `exact` at dt 0.01.
 pub fn dense_config(

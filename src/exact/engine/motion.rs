@@ -44,7 +44,7 @@ impl EventEngine {
     }
 
     /// Moves every circle in a straight line to `t` without processing events (walls fold the
-    /// motion back inside, periodic edges wrap), then predicts afresh. The fallback when a step's
+    /// motion back inside, periodic edges wrap, an open arena lets it go), then predicts afresh. The fallback when a step's
     /// event budget runs out: collisions skipped here show up as overlapping, approaching pairs,
     /// which collide at once on the next advance.
     pub fn drift_to(&mut self, t: f64) {
@@ -55,7 +55,7 @@ impl EventEngine {
             let m = &mut self.motion[i];
             if arena.is_periodic() {
                 p = arena.wrap(p);
-            } else {
+            } else if arena.has_walls() {
                 let r = m.radius * scale;
                 reflect_off_walls(&mut p, &mut v, r, &arena, self.wall_restitution);
             }

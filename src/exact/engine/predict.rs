@@ -237,7 +237,7 @@ impl EventEngine {
                 consider(t, Kind::Segment, k);
             }
         }
-        let walls = !self.grid.periodic;
+        let (walls, periodic) = (self.arena.has_walls(), self.grid.periodic);
         let (min, max): (DVec2, DVec2) = (self.arena.min, self.arena.max);
         let (r, growth) = (
             m.radius * (1.0 + self.growth * since),
@@ -272,12 +272,13 @@ impl EventEngine {
                 (self.cell_y[i] as usize, self.grid.rows - 1)
             };
             let up = v > 0.0;
-            // None past the outer cells of a walled box, nor where one cell spans a period.
-            if (walls && ((up && cell == last) || (!up && cell == 0))) || last == 0 {
+            // None past the outer cells of a walled or open box (the outer cells of an open one
+            // reach on without end), nor where one cell spans a period.
+            if (!periodic && ((up && cell == last) || (!up && cell == 0))) || last == 0 {
                 continue;
             }
             let mut edge = self.grid.edge(a, cell + usize::from(up));
-            if !walls {
+            if periodic {
                 // The reference point is in the arena, the circle may have left it by whole
                 // periods since: the edge is the one in the circle's own image of the arena,
                 // found from where it is now (within half a cell of its cell, and with two
@@ -307,16 +308,24 @@ impl EventEngine {
         if last == 0 {
             return None;
         }
-        let walls = !self.grid.periodic;
         let (mut lo, mut hi) = (self.grid.edge(a, cell), self.grid.edge(a, cell + 1));
-        if !walls {
+        if self.grid.periodic {
             // The cell's image the circle is in now (see `schedule`).
             let middle = lo + 0.5 * self.grid.cell[a];
             let shift = whole_periods(x - middle, self.period[a]);
             (lo, hi) = (lo + shift, hi + shift);
+        } else if !self.arena.has_walls() {
+            // The outer cells of an open arena reach on without end: a circle beyond the
+            // arena stays in its outer cell until it comes back across the inner edge.
+            if cell == 0 {
+                lo = f64::NEG_INFINITY;
+            }
+            if cell == last {
+                hi = f64::INFINITY;
+            }
         }
         let (t, up) = exit_time(x, v, acc, lo, hi)?;
-        let outer = walls && ((up && cell == last) || (!up && cell == 0));
+        let outer = !self.grid.periodic && ((up && cell == last) || (!up && cell == 0));
         (!outer).then_some((self.now - m.t_at + t, up))
     }
 

@@ -174,7 +174,7 @@ impl EventEngine {
         let (p, r) = (self.motion[i].pos, self.motion[i].radius);
         let gap = 10.0 * REST_HEIGHT * r;
         let mut normals: Vec<DVec2> = Vec::new();
-        if !self.arena.is_periodic() {
+        if self.arena.has_walls() {
             for axis in 0..2 {
                 let mut n = DVec2::ZERO;
                 n[axis] = 1.0;

@@ -13,7 +13,7 @@ use crate::segment::{Segment, SegmentCells};
 
 impl EventEngine {
     pub(super) fn hit_wall(&mut self, i: usize, axis: usize) {
-        if self.arena.is_periodic() {
+        if !self.arena.has_walls() {
             return;
         }
         self.advance_circle(i, self.now);
