@@ -128,6 +128,11 @@ impl Checkpoint {
         self.solver
     }
 
+    /// The fixed step, in seconds.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
     /// The checkpoint as bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
         postcard::to_stdvec(self).expect("a checkpoint is plain data")

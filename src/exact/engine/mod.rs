@@ -286,6 +286,23 @@ impl EventEngine {
         }
     }
 
+    /// Lists circle `i` in the cell its position lies in, if that is not the one it is listed
+    /// in: after a move that is not motion (a centre put back inside the walls).
+    fn relist(&mut self, i: usize) {
+        let (x, y) = self.grid.cell_of(self.motion[i].pos);
+        if (x as u32, y as u32) == (self.cell_x[i], self.cell_y[i]) {
+            return;
+        }
+        let listed = self.large_reach(i).is_none();
+        if listed {
+            self.cells.remove(i, self.cell_index(i));
+        }
+        (self.cell_x[i], self.cell_y[i]) = (x as u32, y as u32);
+        if listed {
+            self.cells.insert(i, self.grid.index(x, y));
+        }
+    }
+
     /// Moves circle `i` into the next cell along `axis` (past a periodic edge, the first cell
     /// on the other side). Its course is unchanged, so its motion is left as it is.
     fn cross_cell(&mut self, i: usize, axis: usize, up: bool) {

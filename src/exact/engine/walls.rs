@@ -5,6 +5,7 @@
 use super::EventEngine;
 use super::large::{large_circles, reach};
 use crate::arena::Arena;
+use crate::boundary::put_back_inside;
 use crate::circle::CircleState;
 use crate::collide::contact::combine_restitution;
 use crate::grid::Grid;
@@ -87,13 +88,22 @@ impl EventEngine {
             own => combine_restitution(own[i], self.wall_restitution),
         };
         let bounce = self.contact_time_restitution(&[i], e);
-        let segment = self.segments[k];
+        let (segment, arena) = (self.segments[k], self.arena);
         let m = &mut self.motion[i];
         let (point, out, _) = segment.contact(m.pos, m.vel);
         let vn = m.vel.dot(out);
+        let mut put_back = false;
         if vn < 0.0 {
             // Snap to touching (the event time puts it there up to rounding) and reflect.
             m.pos = point + out * m.radius;
+            if arena.has_walls() && !arena.contains(m.pos) {
+                // Only from a state no run reaches (a circle that began deep in both a segment
+                // wall and an arena wall: a changed solver, wall or checkpoint): the snap would
+                // put its centre past the arena wall. It is put back inside, as the discrete
+                // solvers put back a centre a push-out moved past a wall.
+                put_back_inside(&mut m.pos, m.radius, &arena);
+                put_back = true;
+            }
             let before = m.vel;
             m.vel -= out * ((1.0 + bounce) * vn);
             let speed_change = (m.vel - before).length();
@@ -110,6 +120,9 @@ impl EventEngine {
                     count: 1,
                 });
             }
+        }
+        if put_back {
+            self.relist(i);
         }
         // Pressed against the wall by gravity with no speed, or bounced off it weakly: rest.
         self.rest_on_support(i, -out, e);
@@ -276,5 +289,28 @@ mod tests {
         let spacing = (1.0f64 / 2000.0).sqrt();
         let width = cell_width(&arena, &dilute);
         assert!((1.2 * spacing..2.0 * spacing).contains(&width), "{width}");
+    }
+
+    #[test]
+    fn a_circle_wedged_between_a_segment_and_a_wall_stays_inside() {
+        // A large circle begun deep in a segment wall and the floor at once (a state from the
+        // checkpoint fuzz target): the snap to touching the segment lands its centre below the
+        // floor, and it must be put back inside.
+        let arena = Arena::centered(DVec2::splat(4.0));
+        let segments = [
+            Segment::new(DVec2::new(-2.0, -1.0188), DVec2::new(0.0, 0.0)),
+            Segment::new(DVec2::new(0.0, -1.35), DVec2::new(2.0, -1.2)),
+        ];
+        let circle = CircleState::new(DVec2::new(-0.3, -0.9), DVec2::new(0.0, 0.5), 1.92);
+        let mut engine = EventEngine::new(&[circle], &arena, &segments, 0.5, 0.6);
+        for step in 1..=10 {
+            let _ = engine.advance_to(f64::from(step) / 60.0, 100_000);
+            let at = engine.position(0);
+            assert!(
+                arena.contains(at),
+                "step {step}: the centre left the arena, at {at}"
+            );
+        }
+        assert!(engine.stats().wall_collisions > 0, "it met the segment");
     }
 }
