@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Counts the coloured circles in a screenshot PNG and fails unless there are enough.
 
-Usage: count_circles.py PICTURE.png MIN_CIRCLES
+Usage: count_circles.py PICTURE.png MIN_CIRCLES [MAX_CIRCLES]
 
 Standard library only (the PNG is read by png.py). A pixel is "coloured" when its channels
 differ by more than 60 (the arena, background and HUD are grey); circles are 4-connected blobs
@@ -38,12 +38,14 @@ def count_blobs(width, height, channels, rows, min_pixels=12):
 
 
 def main():
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 4):
         sys.exit(__doc__)
     path, minimum = sys.argv[1], int(sys.argv[2])
+    maximum = int(sys.argv[3]) if len(sys.argv) == 4 else None
     blobs = count_blobs(*read_png(path))
-    print(f"{path}: {blobs} coloured circles (need at least {minimum})")
-    if blobs < minimum:
+    most = "" if maximum is None else f", at most {maximum}"
+    print(f"{path}: {blobs} coloured circles (need at least {minimum}{most})")
+    if blobs < minimum or (maximum is not None and blobs > maximum):
         sys.exit(1)
 
 

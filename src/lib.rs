@@ -112,6 +112,7 @@
 //! - [`effects`]: the registry that keeps exactly the effects a scene calls for in the schedule;
 //! - [`hits`]: collision messages;
 //! - [`diagnostics`]: energy, momentum and pressure after each step;
+//! - [`transform_sync`]: each circle's `Transform` follows its position, interpolated between steps;
 //! - [`render`]: the window, sprites, HUD, keys and the live panel (feature `render`).
 //!
 //! The plain data the kernels work on:
@@ -185,6 +186,7 @@ pub mod segment;
 pub mod sleep;
 pub mod soft;
 pub mod spawn;
+pub mod transform_sync;
 
 use bevy::app::{PluginGroup, PluginGroupBuilder};
 
@@ -199,6 +201,7 @@ use schedule::StepPlugin;
 use sleep::SleepPlugin;
 use soft::SoftPlugin;
 use spawn::SpawnPlugin;
+use transform_sync::TransformSyncPlugin;
 
 /// The common imports: the plugin group and its parts, components, configuration, sets and
 /// what the simulation measures.
@@ -225,6 +228,7 @@ pub mod prelude {
     pub use crate::sleep::{SleepPlugin, Sleeping};
     pub use crate::soft::SoftPlugin;
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
+    pub use crate::transform_sync::{DefaultSmoothing, Smoothing, TransformSyncPlugin};
 }
 
 pub use components::{Mass, Position, Radius, Restitution, Tint, Velocity};
@@ -234,7 +238,8 @@ pub use schedule::CircleSystems;
 /// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
 /// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
 /// [`ContinuousPlugin`] (the `swept` and `exact` solvers), [`SoftPlugin`] (the `soft` contact
-/// solver), [`SleepPlugin`] and [`DiagnosticsPlugin`].
+/// solver), [`SleepPlugin`], [`DiagnosticsPlugin`] and [`TransformSyncPlugin`] (each circle's
+/// `Transform`, if it has one, follows its [`Position`] smoothly between fixed steps).
 ///
 /// An effect plugin schedules its systems only when the configuration calls for the effect,
 /// so an effect a scene does not ask for costs nothing; it stays registered, so a reloaded
@@ -299,5 +304,6 @@ impl PluginGroup for CirclesPlugins {
             .add(SoftPlugin)
             .add(SleepPlugin)
             .add(DiagnosticsPlugin)
+            .add(TransformSyncPlugin::default())
     }
 }

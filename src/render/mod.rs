@@ -2,8 +2,8 @@
 //! at its aspect ratio, one sprite per circle sharing a single disc texture (so thousands draw
 //! in a handful of batched draw calls, each with its own tint), a thin bar per segment wall, and
 //! the [`hud`], [`input`] and [`screenshot`] plugins; the app adds the live [`panel`]. The
-//! simulation never reads anything from here: `Position` is copied into `Transform` once per
-//! frame, after the fixed steps.
+//! simulation never reads anything from here; the core group's
+//! [`transform_sync`](crate::transform_sync) moves the sprites.
 
 pub mod hud;
 pub mod input;
@@ -33,12 +33,7 @@ impl Plugin for CirclesRenderPlugin {
                 Update,
                 draw_segment_walls.run_if(resource_changed::<Segments>),
             )
-            .add_systems(
-                PostUpdate,
-                (attach_sprites, sync_transforms)
-                    .chain()
-                    .before(TransformSystems::Propagate),
-            );
+            .add_systems(PostUpdate, (attach_sprites, resize_sprites).chain());
     }
 }
 
@@ -165,7 +160,12 @@ fn draw_segment_walls(
     commands.spawn_batch(bars);
 }
 
-/// Gives every new circle its sprite.
+/// Marks a circle's sprite given by this plugin (a tinted disc).
+#[derive(Component, Clone, Copy, Debug)]
+pub struct DiscSprite;
+
+/// Gives every new circle without a sprite of its own a tinted disc. Its `Transform` then
+/// follows the circle's position ([`transform_sync`](crate::transform_sync)).
 fn attach_sprites(
     mut commands: Commands,
     disc: Option<Res<DiscTexture>>,
@@ -175,6 +175,7 @@ fn attach_sprites(
     for (entity, position, radius, tint) in &new_circles {
         let [r, g, b] = tint.0;
         commands.entity(entity).insert((
+            DiscSprite,
             Sprite {
                 image: disc.0.clone(),
                 color: Color::srgb_u8(r, g, b),
@@ -186,18 +187,15 @@ fn attach_sprites(
     }
 }
 
-/// Copies the simulation's `Position` (and any changed `Radius`) into what the renderer reads.
-fn sync_transforms(
-    mut circles: Query<(&Position, Ref<Radius>, &mut Transform, &mut Sprite), Changed<Position>>,
-) {
-    circles
-        .par_iter_mut()
-        .for_each(|(position, radius, mut transform, mut sprite)| {
-            transform.translation = position.0.as_vec2().extend(0.0);
-            if radius.is_changed() {
-                sprite.custom_size = Some(Vec2::splat(2.0 * radius.0 as f32));
-            }
-        });
+/// The circles with a sprite of this plugin whose radius changed.
+type ResizedDiscs = (With<DiscSprite>, Changed<Radius>);
+
+/// Keeps the sprites this plugin gave circles the size of their `Radius` (a game's own sprites
+/// are its own to size).
+fn resize_sprites(mut circles: Query<(&Radius, &mut Sprite), ResizedDiscs>) {
+    for (radius, mut sprite) in &mut circles {
+        sprite.custom_size = Some(Vec2::splat(2.0 * radius.0 as f32));
+    }
 }
 
 /// Why the window cannot open here, if that can be told before trying: no X display (the app is
