@@ -3,8 +3,8 @@
 //! Each effect's plugin (gravity and drag in `forces`, walls, segment walls and periodic edges in
 //! `boundary`, collisions in `collide`) owns its systems and hands a recipe for them to
 //! [`register_effect`]. The recipe is used at once if the configuration calls for the effect,
-//! and again by [`reconcile_effects`] when a reloaded scene switches the effect on; switching it
-//! off removes its systems. This module names no system, so it imports none.
+//! and again by [`reconcile_effects`] when a change of the effects, the arena or the segment
+//! walls switches it on; switching it off removes its systems. This module names no system, so it imports none.
 
 use bevy::ecs::intern::Interned;
 use bevy::ecs::schedule::{ScheduleCleanupPolicy, ScheduleConfigs, ScheduleLabel};
@@ -161,8 +161,9 @@ pub fn register_effect(
 }
 
 /// Makes the schedules hold exactly the systems of the registered effects that the world's
-/// [`Effects`], [`Arena`] and [`Segments`] call for: adds the missing ones and removes the rest. Used when a
-/// scene is reloaded while running.
+/// [`Effects`], [`Arena`] and [`Segments`] call for: adds the missing ones and removes the rest.
+/// [`StepPlugin`](crate::schedule::StepPlugin) runs it before a fixed step whenever one of them
+/// changed (game code, a reloaded scene, the panel): the one path by which the schedule follows.
 pub fn reconcile_effects(world: &mut World) {
     let effects = *world.resource::<Effects>();
     let boundary = world.resource::<Arena>().boundary;

@@ -20,6 +20,7 @@ use bevy::prelude::*;
 
 use crate::arena::Arena;
 use crate::config::{Effects, SoftConfig, Solver};
+use crate::effects::reconcile_effects;
 use crate::segment::Segments;
 
 /// The system sets of the simulation, in the order they run.
@@ -117,7 +118,9 @@ impl StopRequest {
 }
 
 /// The core plugin: inserts the arena, segment walls, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
-/// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets.
+/// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets. Before
+/// each fixed step (`FixedFirst`) it reconciles the effects' systems with the [`Effects`],
+/// [`Arena`] and [`Segments`] if any of them changed, however they were changed.
 #[derive(Clone, Debug)]
 pub struct StepPlugin {
     /// The arena the circles live in.
@@ -207,6 +210,16 @@ impl Plugin for StepPlugin {
                     .chain(),
             )
             .add_systems(Startup, allow_long_steps)
+            // Whoever changed the effects, the arena or the segment walls (a game system, a
+            // reloaded scene, the panel), the next step runs the systems they call for.
+            .add_systems(
+                FixedFirst,
+                reconcile_effects.run_if(
+                    resource_changed::<Effects>
+                        .or_eager(resource_changed::<Arena>)
+                        .or_eager(resource_changed::<Segments>),
+                ),
+            )
             .add_systems(FixedUpdate, run_circle_step.in_set(CircleSystems::Step));
     }
 }

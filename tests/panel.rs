@@ -21,7 +21,7 @@ use moving_circles::run::headless_app_with;
 
 /// The classic scene with the panel's state plugin, shown or not.
 fn app(open: bool) -> App {
-    headless_app_with(CirclesConfig::default(), |app| {
+    headless_app_with(moving_circles::scene::classic(), |app| {
         app.init_resource::<ButtonInput<KeyCode>>()
             .add_plugins(PanelStatePlugin { open });
     })
@@ -33,6 +33,12 @@ fn send(app: &mut App, control: Control) {
     app.update();
 }
 
+/// [`send`], then one more frame: the step after a change runs with the systems it calls for.
+fn send_and_step(app: &mut App, control: Control) {
+    send(app, control);
+    app.update();
+}
+
 fn effects(app: &App) -> Effects {
     *app.world().resource::<Effects>()
 }
@@ -41,19 +47,19 @@ fn effects(app: &App) -> Effects {
 fn gravity_and_drag_toggles_add_and_remove_their_systems() {
     let mut app = app(true);
     assert_scheduled(&mut app, "apply_gravity", false);
-    send(&mut app, Control::Gravity(Some(DVec2::new(0.0, -3.0))));
+    send_and_step(&mut app, Control::Gravity(Some(DVec2::new(0.0, -3.0))));
     assert_eq!(effects(&app).gravity, Some(DVec2::new(0.0, -3.0)));
     assert_scheduled(&mut app, "apply_gravity", true);
     // The new system acts: momentum now changes downward step after step.
     let before = energy_momentum(&mut app).1;
     step(&mut app, 10);
     assert!(energy_momentum(&mut app).1.y < before.y, "gravity pulls");
-    send(&mut app, Control::Gravity(None));
+    send_and_step(&mut app, Control::Gravity(None));
     assert_scheduled(&mut app, "apply_gravity", false);
 
-    send(&mut app, Control::Drag(Some(2.0)));
+    send_and_step(&mut app, Control::Drag(Some(2.0)));
     assert_scheduled(&mut app, "apply_drag", true);
-    send(&mut app, Control::Drag(None));
+    send_and_step(&mut app, Control::Drag(None));
     assert_scheduled(&mut app, "apply_drag", false);
     assert_eq!(effects(&app).drag, None);
 }

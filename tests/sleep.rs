@@ -174,6 +174,5 @@ fn nothing_sleeps_without_gravity_and_sleeping_can_be_switched_off() {
     // The heap with sleeping off: never asleep.
     let mut app = heap("soft");
     app.world_mut().resource_mut::<Effects>().sleep.enabled = false;
-    moving_circles::effects::reconcile_effects(app.world_mut());
     assert!(until_asleep(&mut app, 5.0).is_none());
 }

@@ -13,7 +13,6 @@ use bevy::tasks::futures_lite::AsyncReadExt;
 use super::schema::Scene;
 use crate::arena::Arena;
 use crate::config::{CirclesConfig, DropConfig, Effects, Solver, SpawnConfig};
-use crate::effects::reconcile_effects;
 use crate::error::InputError;
 use crate::io::{MAX_SCENE_BYTES, printable, read_limited};
 use crate::schedule::allow_long_steps;
@@ -71,8 +70,8 @@ impl AssetLoader for SceneLoader {
     }
 }
 
-/// Replaces the running simulation's configuration with `config`: arena, solver, effects and
-/// their systems, fixed step, spawn rules; then respawns.
+/// Replaces the running simulation's configuration with `config`: arena, solver, effects (whose
+/// systems the next step reconciles), fixed step, spawn rules; then respawns.
 pub fn apply_config(world: &mut World, config: &CirclesConfig) {
     world.insert_resource::<Arena>(config.arena);
     world.insert_resource::<Solver>(config.solver);
@@ -88,7 +87,6 @@ pub fn apply_config(world: &mut World, config: &CirclesConfig) {
         .resource_mut::<Time<Fixed>>()
         .set_timestep(Duration::from_secs_f64(config.dt));
     let _ = world.run_system_cached(allow_long_steps);
-    reconcile_effects(world);
     world.write_message(Respawn);
 }
 

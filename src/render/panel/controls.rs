@@ -1,6 +1,8 @@
 //! What the panel's sliders and toggles ask for, as [`Control`] messages, and
-//! [`apply_controls`], which makes each change the way a reloaded scene does: effects through
-//! [`reconcile_effects`] (an effect switched off loses its systems), the step through the fixed
+//! [`apply_controls`], which makes each change the way a reloaded scene does: effects by writing
+//! the resource, which the next step reconciles
+//! ([`reconcile_effects`](crate::effects::reconcile_effects): an effect switched off loses its
+//! systems), the step through the fixed
 //! clock, the count through a respawn; `Compare` starts the background comparison. A value that fails the scene's own checks is refused
 //! with a warning, never clamped.
 
@@ -11,7 +13,6 @@ use bevy::prelude::*;
 
 use super::compare::start_comparison;
 use crate::config::{CirclesConfig, Effects, Solver, SpawnConfig};
-use crate::effects::reconcile_effects;
 use crate::schedule::allow_long_steps;
 use crate::spawn::Respawn;
 
@@ -79,7 +80,6 @@ fn apply(world: &mut World, control: Control) -> Result<(), String> {
             }
             effects.check().map_err(|e| e.to_string())?;
             world.insert_resource(effects);
-            reconcile_effects(world);
         }
         Control::Dt(dt) => {
             let config = CirclesConfig {
