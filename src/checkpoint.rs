@@ -258,7 +258,7 @@ impl Checkpoint {
             if !matches!(self.solver, Solver::Soft(_)) {
                 return Err("it holds soft contacts for another solver".to_owned());
             }
-            contacts.check(self.circles.len())?;
+            contacts.check(&self.circles)?;
             if let Some(k) = contacts
                 .segments()
                 .find(|&k| k as usize >= self.segments.0.len())

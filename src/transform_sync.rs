@@ -122,10 +122,7 @@ fn record_step_end(mut circles: Query<(&Position, &mut StepEnds)>) {
 type Untracked = (With<Transform>, Without<StepEnds>);
 
 /// Starts tracking circles that have gained a `Transform`, from where they are.
-fn track_new_circles(
-    mut commands: Commands,
-    new: Query<(Entity, &Position), Untracked>,
-) {
+fn track_new_circles(mut commands: Commands, new: Query<(Entity, &Position), Untracked>) {
     for (entity, position) in &new {
         let here = StepEnds {
             start: position.0,

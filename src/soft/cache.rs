@@ -7,7 +7,15 @@ use bevy::platform::collections::HashMap;
 use serde::{Deserialize, Serialize};
 
 use super::contacts::{Constraint, Partner};
+use crate::circle::CircleState;
 use crate::hits::Wall;
+use crate::range::MAX_MAGNITUDE;
+
+/// Most a cached impulse may change a circle's velocity by, in units of the largest speed an
+/// input may give: two circles at that speed meeting head-on trade four times it, and a
+/// warm start from a forged impulse must not send a circle off at speeds nothing else can
+/// reach (the soft step's energies would overflow).
+const MOST_SPEED_CHANGES: f64 = 8.0;
 
 /// One contact's impulse, kept for the next step under its circle's identity and its partner.
 #[derive(Clone, Copy, Debug)]
@@ -110,7 +118,7 @@ impl ContactCache {
     /// The cache of a checkpoint for circles whose identities are now `ids` (in the order the
     /// checkpoint lists them). Fails, saying why, if it does not fit them.
     pub fn restore(snapshot: &CacheSnapshot, ids: &[u64]) -> Result<Self, String> {
-        snapshot.check(ids.len())?;
+        snapshot.check_lists(ids.len())?;
         let mut start = Vec::with_capacity(ids.len() + 1);
         start.push(0u32);
         for &count in &snapshot.counts {
@@ -193,9 +201,34 @@ pub struct CacheSnapshot {
 }
 
 impl CacheSnapshot {
-    /// Whether it can belong to `n` circles: a count per circle adding up to the entries,
+    /// Whether it can belong to `circles`: a count per circle adding up to the entries,
+    /// partners among them, impulses finite, not negative, and changing no movable circle's
+    /// velocity by more than eight times the largest speed an input may give.
+    pub fn check(&self, circles: &[CircleState]) -> Result<(), String> {
+        self.check_lists(circles.len())?;
+        let owners = self
+            .counts
+            .iter()
+            .enumerate()
+            .flat_map(|(i, &count)| std::iter::repeat_n(i, count as usize));
+        for (i, &(partner, impulse, _)) in owners.zip(&self.entries) {
+            let other = match partner {
+                SnapshotPartner::Circle(k) => circles[k as usize].inv_mass(),
+                SnapshotPartner::Wall(_) => 0.0,
+            };
+            let lightest = circles[i].inv_mass().max(other);
+            if impulse * lightest > MOST_SPEED_CHANGES * MAX_MAGNITUDE {
+                return Err(format!(
+                    "a cached contact impulse of {impulse:e} on circle {i} is beyond any speed"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether its lists fit `n` circles: a count per circle adding up to the entries,
     /// partners among them, impulses finite and not negative.
-    pub fn check(&self, n: usize) -> Result<(), String> {
+    fn check_lists(&self, n: usize) -> Result<(), String> {
         if self.counts.len() != n {
             return Err(format!(
                 "the contact cache lists {} circles, the checkpoint {n}",
@@ -225,5 +258,37 @@ impl CacheSnapshot {
             SnapshotPartner::Wall(Wall::Segment(k)) => Some(k),
             _ => None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::math::DVec2;
+
+    use super::*;
+
+    #[test]
+    fn a_cached_impulse_beyond_any_speed_is_refused() {
+        // Circle 0 has one contact, with circle 1: a light pair (the fuzz target's forged
+        // impulse of 2.6e307 sent them to infinity on the warm start).
+        let light = |x| CircleState::new(DVec2::new(x, 0.0), DVec2::ZERO, 0.1).with_mass(0.03);
+        let circles = [light(0.0), light(0.2)];
+        let cache = |impulse| CacheSnapshot {
+            counts: vec![1, 0],
+            entries: vec![(SnapshotPartner::Circle(1), impulse, true)],
+        };
+        assert!(cache(0.5).check(&circles).is_ok());
+        assert!(cache(1e28).check(&circles).is_ok());
+        for forged in [2.6e307, 1e30, -1.0, f64::NAN] {
+            assert!(cache(forged).check(&circles).is_err(), "{forged} accepted");
+        }
+        // Against a wall only the circle's own mass counts; an immovable circle takes none.
+        let wall = CacheSnapshot {
+            counts: vec![1, 0],
+            entries: vec![(SnapshotPartner::Wall(Wall::Segment(0)), 1e30, true)],
+        };
+        assert!(wall.check(&circles).is_err());
+        let pegs = [circles[0].with_mass(f64::INFINITY), circles[1]];
+        assert!(wall.check(&pegs).is_ok());
     }
 }
