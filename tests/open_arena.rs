@@ -12,14 +12,6 @@ use moving_circles::effects::EffectRegistry;
 use moving_circles::prelude::*;
 use moving_circles::run::Progress;
 
-const SOLVERS: [Solver; 5] = [
-    Solver::Discrete,
-    Solver::Substeps(4),
-    Solver::Soft(4),
-    Solver::Swept,
-    Solver::Exact,
-];
-
 fn open(solver: Solver, gravity: Option<DVec2>, segments: Vec<Segment>) -> CirclesConfig {
     CirclesConfig {
         arena: Arena::centered(DVec2::new(16.0, 9.0)).with_boundary(Boundary::Open),
@@ -35,7 +27,7 @@ fn open(solver: Solver, gravity: Option<DVec2>, segments: Vec<Segment>) -> Circl
 
 #[test]
 fn circles_leave_an_open_arena_and_meet_outside_it() {
-    for solver in SOLVERS {
+    for solver in EVERY_SOLVER {
         let mut app = create_app(open(solver, None, Vec::new()));
         let registry = app.world().resource::<EffectRegistry>();
         assert!(!registry.is_scheduled(Effect::Walls) && !registry.is_scheduled(Effect::Periodic));
@@ -105,7 +97,7 @@ fn in_an_open_arena_segment_walls_hold_what_lands_on_them_and_the_rest_falls_awa
         Segment::new(DVec2::new(-3.0, 0.0), DVec2::new(0.0, -2.0)),
         Segment::new(DVec2::new(0.0, -2.0), DVec2::new(3.0, 0.0)),
     ];
-    for solver in SOLVERS {
+    for solver in EVERY_SOLVER {
         let mut config = open(solver, g, cup.clone());
         config.effects.wall_restitution = 0.2;
         let mut app = create_app(config);

@@ -16,6 +16,15 @@ pub fn create_app(config: CirclesConfig) -> App {
     moving_circles::run::headless_app(config)
 }
 
+/// Every solver, once each: the time-stepped ones, then the continuous ones.
+pub const EVERY_SOLVER: [Solver; 5] = [
+    Solver::Discrete,
+    Solver::Substeps(4),
+    Solver::Soft(4),
+    Solver::Swept,
+    Solver::Exact,
+];
+
 /// A unit box asked for `fraction` of circles of radii `radius` at speed 1, placed by
 /// `placement`, run by `exact` at dt 0.01.
 pub fn dense_config(
