@@ -63,5 +63,8 @@ fn lay_the_floor(totals: Res<StepTotals>, mut segments: ResMut<Segments>) {
         .windows(2)
         .map(|pair| Segment::new(pair[0], pair[1]))
         .collect();
-    println!("t = 0.5 s: floor of {} segment walls built", segments.0.len());
+    println!(
+        "t = 0.5 s: floor of {} segment walls built",
+        segments.0.len()
+    );
 }

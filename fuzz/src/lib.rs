@@ -113,7 +113,11 @@ pub fn checkpoint(data: &[u8]) {
     if checkpoint.circles().len() > MAX_SIMULATED_CIRCLES {
         return;
     }
-    let (solver, source, dt) = (checkpoint.solver(), checkpoint.source.clone(), checkpoint.dt());
+    let (solver, source, dt) = (
+        checkpoint.solver(),
+        checkpoint.source.clone(),
+        checkpoint.dt(),
+    );
     let began_apart = apart(
         checkpoint.circles(),
         checkpoint.arena(),
@@ -229,7 +233,10 @@ fn run(config: &CirclesConfig, solver: Solver) -> (Report, bool) {
         ..config.clone()
     });
     let resolved = resolvable(&mut app, config.dt);
-    (run_steps(&mut app, ORIGIN, SIMULATED_STEPS, 1, |_| {}), resolved)
+    (
+        run_steps(&mut app, ORIGIN, SIMULATED_STEPS, 1, |_| {}),
+        resolved,
+    )
 }
 
 /// Whether the circles in `world` move slowly enough for their positions to be known to within
@@ -243,7 +250,10 @@ fn resolvable(app: &mut bevy::app::App, dt: f64) -> bool {
     let circles = snapshot(app.world_mut());
     let world = app.world();
     let arena = world.resource::<Arena>();
-    let gravity = world.resource::<Effects>().gravity.map_or(0.0, |g| g.length());
+    let gravity = world
+        .resource::<Effects>()
+        .gravity
+        .map_or(0.0, |g| g.length());
     let horizon = world.resource::<StepTotals>().sim_seconds + dt * SIMULATED_STEPS as f64;
     let movable = circles.iter().filter(|c| c.inv_mass() > 0.0);
     let kinetic: f64 = movable
@@ -252,9 +262,15 @@ fn resolvable(app: &mut bevy::app::App, dt: f64) -> bool {
         .sum();
     let lightest = movable.map(|c| c.inv_mass()).fold(0.0, f64::max);
     let fall = 2.0 * gravity * arena.size().max_element();
-    let fastest = circles.iter().map(|c| c.velocity.length()).fold(0.0, f64::max);
+    let fastest = circles
+        .iter()
+        .map(|c| c.velocity.length())
+        .fold(0.0, f64::max);
     let speed = fastest.max((2.0 * kinetic * lightest + fall).sqrt());
-    let smallest = circles.iter().map(|c| c.radius).fold(f64::INFINITY, f64::min);
+    let smallest = circles
+        .iter()
+        .map(|c| c.radius)
+        .fold(f64::INFINITY, f64::min);
     circles.is_empty() || speed * f64::EPSILON * horizon * RESOLUTION_MARGIN <= ROUNDING * smallest
 }
 
