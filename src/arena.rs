@@ -116,6 +116,12 @@ impl Arena {
         self.boundary == Boundary::Periodic
     }
 
+    /// Whether the arena has no edges at all: circles may be anywhere.
+    #[inline]
+    pub fn is_open(&self) -> bool {
+        self.boundary == Boundary::Open
+    }
+
     /// Whether the edges are walls that circles bounce off (and stay within).
     #[inline]
     pub fn has_walls(&self) -> bool {

@@ -7,7 +7,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::{Arena, Boundary};
+use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
 use crate::components::{Mass, Position, Radius, Velocity};
@@ -149,7 +149,7 @@ impl Totals {
                 continue;
             }
             // An open arena has no edge to escape by.
-            totals.escaped += usize::from(arena.boundary != Boundary::Open && !arena.contains(p));
+            totals.escaped += usize::from(!arena.is_open() && !arena.contains(p));
             if !m.is_finite() {
                 continue;
             }

@@ -10,7 +10,7 @@ use std::path::Path;
 use bevy::math::DVec2;
 
 use super::schema::Scene;
-use crate::arena::{Arena, Boundary};
+use crate::arena::Arena;
 use crate::circle::{CircleState, discs};
 use crate::collide::broad_phase::visit_overlapping_pairs;
 use crate::collide::pass::separate_overlaps;
@@ -212,7 +212,7 @@ pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
             ),
         ));
     }
-    if arena.boundary == Boundary::Open {
+    if arena.is_open() {
         return Ok(()); // no edge to be inside of: anywhere in range
     }
     let slack = rounding_slack(c.position, c.radius);

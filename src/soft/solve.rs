@@ -350,7 +350,7 @@ fn restitution(
 /// Puts back a centre that a push or a fast step left outside the arena (walls), or wraps it
 /// (periodic); an open arena leaves it where it is.
 fn keep_inside(bodies: &mut Bodies, arena: &Arena) {
-    if arena.boundary == crate::arena::Boundary::Open {
+    if arena.is_open() {
         return;
     }
     for (p, &r) in bodies.position.iter_mut().zip(&bodies.radius) {

@@ -150,15 +150,8 @@ impl EventEngine {
         self.motion[i].vel = velocity;
         self.motion[i].t_at = self.now;
         self.counter[i] += 1;
-        let listed = self.large_reach(i).is_none();
-        if listed {
-            self.cells.remove(i, self.cell_index(i));
-        }
         let (x, y) = self.grid.cell_of(position);
-        (self.cell_x[i], self.cell_y[i]) = (x as u32, y as u32);
-        if listed {
-            self.cells.insert(i, self.grid.index(x, y));
-        }
+        self.list_in(i, x, y);
         self.predict(i);
     }
 
@@ -290,9 +283,14 @@ impl EventEngine {
     /// in: after a move that is not motion (a centre put back inside the walls).
     fn relist(&mut self, i: usize) {
         let (x, y) = self.grid.cell_of(self.motion[i].pos);
-        if (x as u32, y as u32) == (self.cell_x[i], self.cell_y[i]) {
-            return;
+        if (x as u32, y as u32) != (self.cell_x[i], self.cell_y[i]) {
+            self.list_in(i, x, y);
         }
+    }
+
+    /// Takes circle `i` out of the cell it is listed in and lists it in cell `(x, y)` (a large
+    /// circle is in no cell's list, but knows its cell).
+    fn list_in(&mut self, i: usize, x: usize, y: usize) {
         let listed = self.large_reach(i).is_none();
         if listed {
             self.cells.remove(i, self.cell_index(i));
