@@ -113,6 +113,7 @@
 //! - [`hits`]: collision messages;
 //! - [`diagnostics`]: energy, momentum and pressure after each step;
 //! - [`transform_sync`]: each circle's `Transform` follows its position, interpolated between steps;
+//! - [`query`]: spatial queries for game code: points, overlaps, ray and circle casts;
 //! - [`render`]: the window, sprites, HUD, keys and the live panel (feature `render`).
 //!
 //! The plain data the kernels work on:
@@ -176,6 +177,7 @@ pub mod hits;
 pub mod integrate;
 pub mod io;
 mod lattice;
+pub mod query;
 mod range;
 #[cfg(feature = "render")]
 pub mod render;
@@ -197,6 +199,7 @@ use diagnostics::DiagnosticsPlugin;
 use exact::ContinuousPlugin;
 use forces::{DragPlugin, GravityPlugin};
 use integrate::IntegratePlugin;
+use query::SpatialQueryPlugin;
 use schedule::StepPlugin;
 use sleep::SleepPlugin;
 use soft::SoftPlugin;
@@ -222,6 +225,7 @@ pub mod prelude {
     pub use crate::forces::{DragPlugin, GravityPlugin};
     pub use crate::hits::{ArenaWall, CircleHit, Wall, WallHit};
     pub use crate::integrate::IntegratePlugin;
+    pub use crate::query::{CastHit, QueryFilter, SpatialQuery, SpatialQueryPlugin, Target};
     pub use crate::scene::Scene;
     pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
     pub use crate::segment::{Segment, Segments};
@@ -238,8 +242,9 @@ pub use schedule::CircleSystems;
 /// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
 /// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
 /// [`ContinuousPlugin`] (the `swept` and `exact` solvers), [`SoftPlugin`] (the `soft` contact
-/// solver), [`SleepPlugin`], [`DiagnosticsPlugin`] and [`TransformSyncPlugin`] (each circle's
-/// `Transform`, if it has one, follows its [`Position`] smoothly between fixed steps).
+/// solver), [`SleepPlugin`], [`DiagnosticsPlugin`], [`TransformSyncPlugin`] (each circle's
+/// `Transform`, if it has one, follows its [`Position`] smoothly between fixed steps) and
+/// [`SpatialQueryPlugin`] (the index behind [`SpatialQuery`](query::SpatialQuery)).
 ///
 /// An effect plugin schedules its systems only when the configuration calls for the effect,
 /// so an effect a scene does not ask for costs nothing; it stays registered, so a reloaded
@@ -305,5 +310,6 @@ impl PluginGroup for CirclesPlugins {
             .add(SleepPlugin)
             .add(DiagnosticsPlugin)
             .add(TransformSyncPlugin::default())
+            .add(SpatialQueryPlugin)
     }
 }

@@ -82,6 +82,17 @@ impl CellList {
         &self.order
     }
 
+    /// The grid the circles are binned into.
+    pub(crate) fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The positions in [`Self::order`] of the circles in cell `c`.
+    #[inline]
+    pub(crate) fn cell_range(&self, c: usize) -> std::ops::Range<usize> {
+        self.start[c] as usize..self.start[c + 1] as usize
+    }
+
     fn fill(&mut self, circles: &[(DVec2, f64)]) {
         let cells = self.grid.len();
         let mut cell_of = std::mem::take(&mut self.cell_of);
