@@ -250,6 +250,16 @@ impl Checkpoint {
         if numbers.iter().any(|x| !x.is_finite()) {
             return Err("a counter or total is not finite".to_owned());
         }
+        // The clock is the sum of `steps` steps of `dt`, to the rounding of such a sum: a clock
+        // run backwards or far ahead would change how finely event times resolve.
+        let clock = self.steps.steps as f64 * self.dt;
+        let rounding = (self.steps.steps as f64 + 1.0) * f64::EPSILON * clock;
+        if (self.steps.sim_seconds - clock).abs() > rounding {
+            return Err(format!(
+                "its clock {:?} s is not {} steps of {:?} s",
+                self.steps.sim_seconds, self.steps.steps, self.dt
+            ));
+        }
         // No engine under `exact` is a build a signal stopped: the next step builds one.
         if self.engine.is_some() && self.solver != Solver::Exact {
             return Err("the engine state does not match the solver".to_owned());
@@ -372,5 +382,33 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("impossible radius"), "{error}");
+    }
+
+    #[test]
+    fn a_clock_that_is_not_its_steps_is_refused() {
+        let mut app = headless_app(CirclesConfig {
+            solver: Solver::Swept,
+            ..default()
+        });
+        for _ in 0..40 {
+            app.update();
+        }
+        let progress = Progress::start(app.world_mut());
+        let good = Checkpoint::take(app.world_mut(), "t", &progress);
+        assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+        // Run backwards (the fuzzer's find: a negative clock hid how coarsely a fast circle's
+        // events resolve) or far ahead.
+        for clock in [
+            -good.steps.sim_seconds,
+            1e12,
+            good.steps.sim_seconds * (1.0 + 1e-9),
+        ] {
+            let mut bad = good.clone();
+            bad.steps.sim_seconds = clock;
+            let error = Checkpoint::from_bytes(&bad.to_bytes(), "c")
+                .unwrap_err()
+                .to_string();
+            assert!(error.contains("its clock"), "{error}");
+        }
     }
 }
