@@ -8,7 +8,7 @@
 use bevy::math::DVec2;
 
 use super::shapes::ray_disc;
-use crate::arena::{Arena, minimum_image};
+use crate::arena::Arena;
 use crate::collide::broad_phase::{CellList, needs_levels, radius_range};
 use crate::grid::Grid;
 
@@ -23,8 +23,8 @@ const MAX_LEVELS: usize = 64;
 #[derive(Debug, Default, Clone)]
 pub struct CircleIndex {
     levels: Vec<Level>,
-    /// The periodic box (`min`, `size`), if the arena wraps.
-    period: Option<(DVec2, DVec2)>,
+    /// The arena it was built for.
+    arena: Arena,
     /// Circles of one level while building, reused.
     local: Vec<(DVec2, f64)>,
 }
@@ -54,7 +54,7 @@ impl CircleIndex {
     /// Rebuilds the index over `circles` (centre, radius) in `arena`, reusing its memory.
     /// Circles with a non-finite centre are left out.
     pub fn build(&mut self, circles: &[(DVec2, f64)], arena: &Arena) {
-        self.period = arena.is_periodic().then(|| (arena.min, arena.size()));
+        self.arena = *arena;
         let range = radius_range(circles);
         let level_of = |r: f64| {
             if needs_levels(range) {
@@ -75,20 +75,20 @@ impl CircleIndex {
             self.local.clear();
             level.sorted.clear();
             for (i, &(centre, radius)) in members {
-                let centre = match self.period {
-                    Some(_) if centre.is_finite() => arena.wrap(centre),
-                    _ => centre,
-                };
+                let periodic = arena.is_periodic() && centre.is_finite();
+                let centre = if periodic { arena.wrap(centre) } else { centre };
                 self.local.push((centre, radius));
                 level.sorted.push((centre, radius, i as u32));
             }
             level.max_radius = radius_range(&self.local).1;
             let min_cell = 2.0 * level.max_radius;
-            match self.period {
-                Some((min, size)) => level
+            if arena.is_periodic() {
+                let (min, size) = (arena.min, arena.size());
+                level
                     .cells
-                    .rebuild_periodic(&self.local, min, size, min_cell),
-                None => level.cells.rebuild(&self.local, min_cell),
+                    .rebuild_periodic(&self.local, min, size, min_cell);
+            } else {
+                level.cells.rebuild(&self.local, min_cell);
             }
             let unsorted = std::mem::take(&mut level.sorted);
             level
@@ -102,13 +102,11 @@ impl CircleIndex {
     /// distance), with `offset` from `p` to its centre (the minimum image on a periodic
     /// arena). Each circle comes at most once.
     pub fn for_each_near(&self, p: DVec2, reach: f64, mut visit: impl FnMut(u32, DVec2, f64)) {
-        let p = match self.period {
-            Some((min, size)) => min + (p - min).rem_euclid(size),
-            None => p,
-        };
-        let offset = |d: DVec2| match self.period {
-            Some((_, size)) => minimum_image(d, size),
-            None => d,
+        let arena = &self.arena;
+        let p = if arena.is_periodic() {
+            arena.wrap(p)
+        } else {
+            p
         };
         if !p.is_finite() {
             return;
@@ -127,7 +125,7 @@ impl CircleIndex {
                 for x in xs.0..xs.0 + xs.1 as i64 {
                     let c = grid.index(wrap(x, grid.cols), wrap(y, grid.rows));
                     for &(centre, radius, i) in &level.sorted[level.cells.cell_range(c)] {
-                        visit(i, offset(centre - p), radius);
+                        visit(i, arena.offset(p, centre), radius);
                     }
                 }
             }
@@ -152,13 +150,13 @@ impl CircleIndex {
         if !(origin.is_finite() && direction.is_finite() && radius >= 0.0 && max_distance >= 0.0) {
             return None;
         }
-        let (start, shift, max_distance) = match self.period {
-            Some((min, size)) => {
-                let wrapped = min + (origin - min).rem_euclid(size);
-                let reach = PERIODIC_REACH * size.length();
-                (wrapped, origin - wrapped, max_distance.min(reach))
-            }
-            None => (origin, DVec2::ZERO, max_distance),
+        let arena = &self.arena;
+        let (start, shift, max_distance) = if arena.is_periodic() {
+            let wrapped = arena.wrap(origin);
+            let reach = PERIODIC_REACH * arena.size().length();
+            (wrapped, origin - wrapped, max_distance.min(reach))
+        } else {
+            (origin, DVec2::ZERO, max_distance)
         };
         let ray = Ray {
             origin: start,
@@ -168,7 +166,12 @@ impl CircleIndex {
         };
         let mut best: Option<CircleHitAt> = None;
         for level in &self.levels {
-            ray.walk(level, self.period.map(|p| p.1), &accept, &mut best);
+            ray.walk(
+                level,
+                arena.is_periodic().then(|| arena.size()),
+                &accept,
+                &mut best,
+            );
         }
         best.map(|hit| CircleHitAt {
             centre: hit.centre + shift,

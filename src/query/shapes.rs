@@ -7,6 +7,7 @@
 
 use bevy::math::DVec2;
 
+use crate::exact::toi::{pair_time_of_impact, segment_time_of_impact};
 use crate::segment::Segment;
 
 /// Distance `t ≥ 0` along the unit `direction` from `origin` at which the ray first meets the
@@ -23,19 +24,12 @@ use crate::segment::Segment;
 /// ```
 #[inline]
 pub fn ray_disc(origin: DVec2, direction: DVec2, centre: DVec2, radius: f64) -> Option<f64> {
-    let m = origin - centre;
-    let c = m.length_squared() - radius * radius;
-    if c <= 0.0 {
+    // Solid: from inside, met at once, whichever way the ray points; else the circles' time of
+    // impact (NaN-safe: no meeting with a disc that is not there).
+    if (origin - centre).length_squared() <= radius * radius {
         return Some(0.0);
     }
-    let b = m.dot(direction);
-    let discriminant = b * b - c;
-    // Written to refuse NaN too: no meeting with a disc that is not there.
-    if !(b < 0.0 && discriminant >= 0.0) {
-        return None;
-    }
-    // The nearer root, as c / (−b + √D) to keep precision when the disc is far away.
-    Some((c / (-b + discriminant.sqrt())).max(0.0))
+    pair_time_of_impact(origin - centre, direction, radius)
 }
 
 /// Distance `t ≥ 0` along the unit `direction` from `origin` at which the ray first comes
@@ -53,30 +47,11 @@ pub fn ray_disc(origin: DVec2, direction: DVec2, centre: DVec2, radius: f64) -> 
 /// assert_eq!(ray_capsule(DVec2::new(2.0, 3.0), -DVec2::Y, &floor, 0.5), None);
 /// ```
 pub fn ray_capsule(origin: DVec2, direction: DVec2, segment: &Segment, radius: f64) -> Option<f64> {
+    // Solid, as `ray_disc`; else the segment walls' time of impact at unit speed.
     if segment.distance(origin) <= radius {
         return Some(0.0);
     }
-    let ends = [segment.a, segment.b]
-        .into_iter()
-        .filter_map(|end| ray_disc(origin, direction, end, radius));
-    let along = segment.b - segment.a;
-    let normal = segment.normal();
-    let side = (normal != DVec2::ZERO)
-        .then(|| {
-            // The face of the capsule on the origin's side: the segment's line moved out by
-            // `radius`; the ray meets it where its height above the line drops to `radius`.
-            let height = (origin - segment.a).dot(normal);
-            let rate = direction.dot(normal);
-            // Within the slab but outside the capsule, the ray enters by a round end.
-            if height.abs() <= radius || height * rate >= 0.0 {
-                return None;
-            }
-            let t = (height.abs() - radius) / rate.abs();
-            let s = (origin + direction * t - segment.a).dot(along) / along.length_squared();
-            (0.0..=1.0).contains(&s).then_some(t)
-        })
-        .flatten();
-    ends.chain(side).min_by(f64::total_cmp)
+    segment_time_of_impact(origin, direction, radius, segment)
 }
 
 /// The contact a circle of `radius` centred at `at` makes with a disc of `disc_radius` about
