@@ -205,11 +205,19 @@ impl SegmentCells {
     }
 
     /// Lists for looking up the segments near a circle anywhere in `arena`: cells about one
-    /// segment long, at most about four per segment.
+    /// segment long, at most about four per segment. An open arena's segments may lie outside
+    /// its rectangle: the cells then cover them too (a circle beyond every cell is looked up
+    /// in the nearest edge cells, which list every segment near that edge).
     pub fn over_arena(segments: &[Segment], arena: &Arena) -> Self {
         let total: f64 = segments.iter().map(Segment::length).sum();
         let mean = total / segments.len().max(1) as f64;
-        let grid = Grid::tiling(arena.min, arena.size(), mean, segments.len(), false);
+        let (mut lo, mut hi) = (arena.min, arena.max);
+        if arena.is_open() {
+            for s in segments {
+                (lo, hi) = (lo.min(s.a).min(s.b), hi.max(s.a).max(s.b));
+            }
+        }
+        let grid = Grid::tiling(lo, hi - lo, mean, segments.len(), false);
         Self::build(segments, grid, 0.0)
     }
 
