@@ -1,6 +1,7 @@
 //! The windowed app's side (cargo feature `render`): a camera that keeps the whole arena in view
 //! at its aspect ratio, one sprite per circle sharing a single disc texture (so thousands draw
-//! in a handful of batched draw calls, each with its own tint), a thin bar per segment wall, and
+//! in a handful of batched draw calls, each with its own tint; a darker radius on the disc
+//! turns with the circle's [`Rotation`]), a thin bar per segment wall, and
 //! the [`hud`], [`input`] and [`screenshot`] plugins; the app adds the live [`panel`]. The
 //! simulation never reads anything from here; the core group's
 //! [`transform_sync`](crate::transform_sync) moves the sprites.
@@ -16,7 +17,7 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 
 use crate::arena::Arena;
-use crate::components::{Position, Radius, Tint};
+use crate::components::{Position, Radius, Rotation, Tint};
 use crate::segment::Segments;
 
 /// Everything the window shows: arena, circles, HUD and the keyboard and mouse controls.
@@ -33,11 +34,15 @@ impl Plugin for CirclesRenderPlugin {
                 Update,
                 draw_segment_walls.run_if(resource_changed::<Segments>),
             )
-            .add_systems(PostUpdate, (attach_sprites, resize_sprites).chain());
+            .add_systems(
+                PostUpdate,
+                (attach_sprites, resize_sprites, turn_sprites).chain(),
+            );
     }
 }
 
-/// The one texture every circle sprite shares: a white anti-aliased disc, tinted per circle.
+/// The one texture every circle sprite shares: a white anti-aliased disc, tinted per circle,
+/// with a darker radius towards its right (at rotation 0) that shows how far it has turned.
 #[derive(Resource, Clone, Debug)]
 pub struct DiscTexture(pub Handle<Image>);
 
@@ -53,10 +58,14 @@ fn create_disc_texture(mut commands: Commands, mut images: ResMut<Assets<Image>>
     let mut data = Vec::with_capacity((DISC_PIXELS * DISC_PIXELS * 4) as usize);
     for y in 0..DISC_PIXELS {
         for x in 0..DISC_PIXELS {
-            let d = Vec2::new(x as f32 + 0.5 - radius, y as f32 + 0.5 - radius).length();
+            let offset = Vec2::new(x as f32 + 0.5 - radius, y as f32 + 0.5 - radius);
+            let d = offset.length();
             // One pixel of soft edge; coverage in alpha, colour white so `Sprite::color` tints it.
             let alpha = (radius - d).clamp(0.0, 1.0);
-            data.extend_from_slice(&[255, 255, 255, (alpha * 255.0) as u8]);
+            // The mark: a band 1/16 of the diameter wide from the centre to near the edge.
+            let mark = offset.x > 0.0 && offset.y.abs() < size / 32.0 && d < radius - 3.0;
+            let grey = if mark { 140 } else { 255 };
+            data.extend_from_slice(&[grey, grey, grey, (alpha * 255.0) as u8]);
         }
     }
     let image = Image::new(
@@ -186,6 +195,17 @@ fn attach_sprites(
         ));
     }
 }
+
+/// Turns the sprites this plugin gave circles as the circles turn (a game's own sprites are
+/// its own to turn: it reads [`Rotation`] as this does).
+fn turn_sprites(mut circles: Query<(&Rotation, &mut Transform), TurnedDiscs>) {
+    for (rotation, mut transform) in &mut circles {
+        transform.rotation = Quat::from_rotation_z(rotation.0 as f32);
+    }
+}
+
+/// The circles with a sprite of this plugin that turned.
+type TurnedDiscs = (With<DiscSprite>, Changed<Rotation>);
 
 /// The circles with a sprite of this plugin whose radius changed.
 type ResizedDiscs = (With<DiscSprite>, Changed<Radius>);
