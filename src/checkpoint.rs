@@ -14,7 +14,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
-use crate::components::Sleep;
+use crate::components::{AngularVelocity, Rotation, Sleep};
 use crate::config::{
     CirclesConfig, DropConfig, Effects, MAX_CIRCLES, MassModel, SoftConfig, Solver, SpawnConfig,
     min_radius,
@@ -23,7 +23,7 @@ use crate::error::InputError;
 use crate::exact::EngineState;
 use crate::exact::engine::EngineSnapshot;
 use crate::io::read_bytes_limited;
-use crate::range::{check_mass, check_vector};
+use crate::range::{check_magnitude, check_mass, check_vector};
 use crate::run::{Progress, headless_app};
 use crate::schedule::StepTotals;
 use crate::segment::Segments;
@@ -32,7 +32,7 @@ use crate::soft::{CacheSnapshot, SoftState};
 use crate::spawn::{Dropped, SpawnReport};
 
 /// The first field of every checkpoint: what it is and the layout's version.
-const FORMAT: &str = "moving_circles checkpoint 5";
+const FORMAT: &str = "moving_circles checkpoint 6";
 /// Most bytes a checkpoint may have: the most circles an input may ask for, each with its
 /// engine state, fit.
 pub const MAX_CHECKPOINT_BYTES: u64 = 2 << 30;
@@ -57,6 +57,8 @@ pub struct Checkpoint {
     circles: Vec<CircleState>,
     /// Each circle's sleep, in the order of `circles`.
     sleep: Vec<Sleep>,
+    /// Each circle's rotation and angular velocity, in the order of `circles`.
+    spin: Vec<(f64, f64)>,
     steps: StepTotals,
     pairs: PairCollisions,
     walls: WallCollisions,
@@ -94,9 +96,19 @@ impl Checkpoint {
             dropped: world.resource::<Dropped>().count,
             requested: world.resource::<SpawnReport>().requested,
             circles: snapshot(world),
-            sleep: snapshot_with_entities(world)
+            sleep: entities
                 .iter()
-                .map(|&(e, _)| world.get::<Sleep>(e).copied().unwrap_or_default())
+                .map(|&e| world.get::<Sleep>(e).copied().unwrap_or_default())
+                .collect(),
+            spin: entities
+                .iter()
+                .map(|&e| {
+                    let rotation = world.get::<Rotation>(e).map_or(0.0, |r| r.0);
+                    (
+                        rotation,
+                        world.get::<AngularVelocity>(e).map_or(0.0, |w| w.0),
+                    )
+                })
                 .collect(),
             steps: *world.resource::<StepTotals>(),
             pairs: *world.resource::<PairCollisions>(),
@@ -199,6 +211,22 @@ impl Checkpoint {
                 self.sleep.len(),
                 self.circles.len()
             ));
+        }
+        if self.spin.len() != self.circles.len() {
+            return Err(format!(
+                "holds the spin of {} circles for {}",
+                self.spin.len(),
+                self.circles.len()
+            ));
+        }
+        // A rotation is kept in [-π, π]; a surface may turn no faster than any speed.
+        let pi = std::f64::consts::PI;
+        for (i, (&(angle, w), c)) in self.spin.iter().zip(&self.circles).enumerate() {
+            if !(-pi..=pi).contains(&angle) || check_magnitude("", w * c.radius).is_err() {
+                return Err(format!(
+                    "circle {i} has rotation {angle:?}, angular velocity {w:?}"
+                ));
+            }
         }
         if let Some(i) = self
             .sleep
@@ -321,9 +349,16 @@ impl Checkpoint {
                 "its circles did not come back as they were written",
             ));
         }
-        for (&(entity, _), &sleep) in circles.iter().zip(&self.sleep) {
+        for ((&(entity, _), &sleep), &(angle, w)) in circles.iter().zip(&self.sleep).zip(&self.spin)
+        {
             if let Some(mut kept) = world.get_mut::<Sleep>(entity) {
                 *kept = sleep;
+            }
+            if let Some(mut rotation) = world.get_mut::<Rotation>(entity) {
+                rotation.0 = angle;
+            }
+            if let Some(mut spin) = world.get_mut::<AngularVelocity>(entity) {
+                spin.0 = w;
             }
         }
         world.resource_mut::<Sleeping>().count = self.sleep.iter().filter(|s| s.asleep).count();

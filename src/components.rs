@@ -1,5 +1,5 @@
-//! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass`, `Tint` and
-//! `Sleep`, and the optional `Restitution`.
+//! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass`, `Tint`,
+//! `Sleep`, `Rotation` and `AngularVelocity`, and the optional `Restitution` and `Friction`.
 //!
 //! `Position` is deliberately not `Transform`: the simulation owns it, and the render side copies
 //! it into `Transform` only when rendering is on. Inserting a [`Radius`] is what makes an entity a
@@ -22,7 +22,7 @@ pub struct Velocity(pub DVec2);
 /// Radius of a circle. Must be finite and positive; inserting it makes the entity a circle.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Debug)]
-#[require(Position, Velocity, Mass, Tint, Sleep)]
+#[require(Position, Velocity, Mass, Tint, Sleep, Rotation, AngularVelocity)]
 pub struct Radius(pub f64);
 
 /// Mass of a circle.
@@ -88,6 +88,51 @@ impl Mass {
 #[reflect(Component, Debug)]
 pub struct Restitution(pub f64);
 
+/// How fast a circle turns, in radians per second, counter-clockwise positive. Every solver
+/// turns a circle's [`Rotation`] by it; friction (under `soft`) changes it. A circle without
+/// this component never turns: friction then acts on it as on a body that cannot roll.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Default, Debug)]
+pub struct AngularVelocity(pub f64);
+
+/// How far a circle has turned since it was spawned: an angle in radians, counter-clockwise,
+/// kept in `[-π, π]`. It changes nothing in the physics of a circle (a disc looks the same
+/// at every angle); it is there so a game can draw a marked ball turning.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Default, Debug)]
+pub struct Rotation(pub f64);
+
+impl Rotation {
+    /// This rotation turned on by `angle` radians, kept in `[-π, π]`.
+    ///
+    /// ```
+    /// use moving_circles::prelude::*;
+    ///
+    /// let turned = Rotation(3.0).turned(1.0);
+    /// assert!((turned.0 - (4.0 - std::f64::consts::TAU)).abs() < 1e-15);
+    /// ```
+    #[inline]
+    pub fn turned(self, angle: f64) -> Self {
+        let a = self.0 + angle;
+        if (-std::f64::consts::PI..=std::f64::consts::PI).contains(&a) {
+            Self(a)
+        } else {
+            // `rem_euclid` keeps the angle's rounding to that of one addition per turn.
+            let r = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU);
+            Self(r - std::f64::consts::PI)
+        }
+    }
+}
+
+/// A circle's own friction coefficient (Coulomb's μ, 0 or more); without it a circle takes
+/// the scene's (`effects.friction` against circles, `effects.wall_friction` against walls).
+/// Two values meet as the scene's `effects.friction_combine` says (their geometric mean by
+/// default), against other circles and walls alike. Friction acts under the contact solver
+/// `soft`; the other solvers treat circles as smooth.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Debug)]
+pub struct Friction(pub f64);
+
 /// Display colour of a circle as sRGB bytes, as in the plain-text particle format (`r g b`).
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Eq, Deref, DerefMut)]
 #[reflect(Component, Default, Debug)]
@@ -130,8 +175,17 @@ pub type SolverCircles<'w, 's> = Query<
         &'static Mass,
         Option<&'static Restitution>,
         &'static Sleep,
+        Spin,
     ),
 >;
+
+/// How a circle turns, as the solvers read and write it: its angular velocity and rotation
+/// (either may be absent: the circle then does not turn) and its own friction.
+pub type Spin = (
+    Option<&'static mut AngularVelocity>,
+    Option<&'static mut Rotation>,
+    Option<&'static Friction>,
+);
 
 impl From<DVec2> for Position {
     fn from(v: DVec2) -> Self {

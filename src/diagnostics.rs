@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
-use crate::components::{Mass, Position, Radius, Velocity};
+use crate::components::{AngularVelocity, Mass, Position, Radius, Velocity};
 use crate::config::Effects;
 use crate::schedule::{CircleSystems, StepTotals};
 use crate::spawn::SpawnReport;
@@ -118,11 +118,15 @@ pub struct Totals {
     pub count: usize,
     /// `Σ ½ m |v|²`.
     pub kinetic_energy: f64,
+    /// `Σ ½ I ω²`: the energy of turning, each circle a uniform disc (`I = m r² / 2`).
+    pub rotational_energy: f64,
     /// `Σ m g·(floor - x)`, measured from the arena's lowest corner along `g` (0 without
     /// gravity).
     pub potential_energy: f64,
     /// `Σ m v`.
     pub momentum: DVec2,
+    /// Angular momentum about the origin: `Σ (m x × v + I ω)`.
+    pub angular_momentum: f64,
     /// Circles with a non-finite position or velocity.
     pub non_finite: usize,
     /// Centres outside the arena.
@@ -130,10 +134,10 @@ pub struct Totals {
 }
 
 impl Totals {
-    /// Measures `(position, velocity, mass)` triples. Immovable (infinite-mass) circles carry no
-    /// energy or momentum.
+    /// Measures circles given as `(position, velocity, mass, radius, angular velocity)`.
+    /// Immovable (infinite-mass) circles carry no energy or momentum.
     pub fn measure(
-        circles: impl Iterator<Item = (DVec2, DVec2, f64)>,
+        circles: impl Iterator<Item = (DVec2, DVec2, f64, f64, f64)>,
         arena: &Arena,
         gravity: Option<DVec2>,
     ) -> Self {
@@ -142,9 +146,9 @@ impl Totals {
         // negative and a relative drift stays meaningful.
         let floor = DVec2::select(g.cmpgt(DVec2::ZERO), arena.max, arena.min);
         let mut totals = Self::default();
-        for (p, v, m) in circles {
+        for (p, v, m, r, w) in circles {
             totals.count += 1;
-            if !(p.is_finite() && v.is_finite()) {
+            if !(p.is_finite() && v.is_finite() && w.is_finite()) {
                 totals.non_finite += 1;
                 continue;
             }
@@ -157,13 +161,19 @@ impl Totals {
             totals.kinetic_energy += 0.5 * m * v.length_squared();
             totals.potential_energy += m * g.dot(floor - p);
             totals.momentum += m * v;
+            let inertia = 0.5 * m * r * r;
+            totals.angular_momentum += m * p.perp_dot(v);
+            if w != 0.0 {
+                totals.rotational_energy += 0.5 * inertia * w * w;
+                totals.angular_momentum += inertia * w;
+            }
         }
         totals
     }
 
-    /// Kinetic plus potential energy.
+    /// Kinetic (moving and turning) plus potential energy.
     pub fn energy(&self) -> f64 {
-        self.kinetic_energy + self.potential_energy
+        self.kinetic_energy + self.rotational_energy + self.potential_energy
     }
 }
 
@@ -212,10 +222,19 @@ fn measure(
     arena: Res<Arena>,
     effects: Res<Effects>,
     mut diagnostics: ResMut<CircleDiagnostics>,
-    circles: Query<(&Position, &Velocity, &Mass), With<Radius>>,
+    circles: Query<(
+        &Position,
+        &Velocity,
+        &Mass,
+        &Radius,
+        Option<&AngularVelocity>,
+    )>,
 ) {
+    let spin = |w: Option<&AngularVelocity>| w.map_or(0.0, |w| w.0);
     let totals = Totals::measure(
-        circles.iter().map(|(p, v, m)| (p.0, v.0, m.0)),
+        circles
+            .iter()
+            .map(|(p, v, m, r, w)| (p.0, v.0, m.0, r.0, spin(w))),
         &arena,
         effects.gravity,
     );

@@ -1,8 +1,9 @@
-//! Free flight: `x += v·dt` over the step's `dt` ([`StepDt`]), in [`CircleSystems::Integrate`].
+//! Free flight: `x += v·dt`, and each circle turned by its angular velocity, over the step's
+//! `dt` ([`StepDt`]), in [`CircleSystems::Integrate`].
 
 use bevy::prelude::*;
 
-use crate::components::{Position, Sleep, Velocity};
+use crate::components::{AngularVelocity, Position, Rotation, Sleep, SolverCircles, Velocity};
 use crate::schedule::{CircleStep, CircleSystems, StepDt};
 
 /// Moves every circle along its velocity for one (sub)step.
@@ -13,6 +14,8 @@ impl Plugin for IntegratePlugin {
     fn build(&self, app: &mut App) {
         app.register_type::<Position>()
             .register_type::<Velocity>()
+            .register_type::<Rotation>()
+            .register_type::<AngularVelocity>()
             .add_systems(
                 CircleStep,
                 integrate_positions.in_set(CircleSystems::Integrate),
@@ -20,14 +23,42 @@ impl Plugin for IntegratePlugin {
     }
 }
 
-/// `x += v·dt` for every circle awake. Each circle is independent, so this runs in parallel.
-fn integrate_positions(dt: Res<StepDt>, mut circles: Query<(&mut Position, &Velocity, &Sleep)>) {
+/// The circles as free flight moves them: where they are and how they turn.
+type Flying = (
+    &'static mut Position,
+    &'static Velocity,
+    &'static Sleep,
+    Option<(&'static mut Rotation, &'static AngularVelocity)>,
+);
+
+/// `x += v·dt` for every circle awake, and its rotation turned by `ω·dt` (only circles that
+/// turn are written). Each circle is independent, so this runs in parallel.
+fn integrate_positions(dt: Res<StepDt>, mut circles: Query<Flying>) {
     let dt = dt.0;
     circles
         .par_iter_mut()
-        .for_each(|(mut position, velocity, sleep)| {
-            if !sleep.asleep {
-                position.0 += velocity.0 * dt;
+        .for_each(|(mut position, velocity, sleep, spin)| {
+            if sleep.asleep {
+                return;
+            }
+            position.0 += velocity.0 * dt;
+            if let Some((mut rotation, spin)) = spin
+                && spin.0 != 0.0
+            {
+                *rotation = rotation.turned(spin.0 * dt);
             }
         });
+}
+
+/// Turns every circle awake by its angular velocity over `dt` (for a solver that moves the
+/// circles itself and changes no spin: `swept`, `exact`).
+pub fn turn_circles(circles: &mut SolverCircles, dt: f64) {
+    for (.., sleep, (spin, rotation, _)) in circles.iter_mut() {
+        if let (Some(spin), Some(mut rotation)) = (spin, rotation)
+            && spin.0 != 0.0
+            && !sleep.asleep
+        {
+            *rotation = rotation.turned(spin.0 * dt);
+        }
+    }
 }

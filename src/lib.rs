@@ -214,10 +214,13 @@ pub mod prelude {
     pub use crate::boundary::{PeriodicPlugin, SegmentsPlugin, WallCollisions, WallsPlugin};
     pub use crate::circle::CircleState;
     pub use crate::collide::{CollidePlugin, PairCollisions};
-    pub use crate::components::{Mass, Position, Radius, Restitution, Sleep, Tint, Velocity};
+    pub use crate::components::{
+        AngularVelocity, Friction, Mass, Position, Radius, Restitution, Rotation, Sleep, Tint,
+        Velocity,
+    };
     pub use crate::config::{
-        CirclesConfig, DropConfig, Effects, MassModel, Placement, SleepConfig, SoftConfig, Solver,
-        SpawnConfig,
+        CirclesConfig, Combine, DropConfig, Effects, MassModel, Placement, SleepConfig, SoftConfig,
+        Solver, SpawnConfig,
     };
     pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin, Measuring};
     pub use crate::effects::Effect;
@@ -235,7 +238,9 @@ pub mod prelude {
     pub use crate::transform_sync::{DefaultSmoothing, Smoothing, TransformSyncPlugin};
 }
 
-pub use components::{Mass, Position, Radius, Restitution, Tint, Velocity};
+pub use components::{
+    AngularVelocity, Friction, Mass, Position, Radius, Restitution, Rotation, Tint, Velocity,
+};
 pub use schedule::CircleSystems;
 
 /// The simulation as a plugin group: [`StepPlugin`] (first: the others build on it),

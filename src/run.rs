@@ -17,7 +17,7 @@ use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, discs, snapshot};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::components::Sleep;
+use crate::components::{AngularVelocity, Mass, Position, Radius, Sleep, Velocity};
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
@@ -196,9 +196,18 @@ fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl Fn
 
 /// Mechanical energy, momentum and counts of the world's circles under its arena and gravity.
 fn totals(world: &mut World) -> Totals {
-    let circles = snapshot(world);
+    let mut circles = world.query::<(
+        &Position,
+        &Velocity,
+        &Mass,
+        &Radius,
+        Option<&AngularVelocity>,
+    )>();
+    let spin = |w: Option<&AngularVelocity>| w.map_or(0.0, |w| w.0);
     Totals::measure(
-        circles.iter().map(|c| (c.position, c.velocity, c.mass)),
+        circles
+            .iter(world)
+            .map(|(p, v, m, r, w)| (p.0, v.0, m.0, r.0, spin(w))),
         world.resource::<Arena>(),
         world.resource::<Effects>().gravity,
     )
@@ -240,6 +249,10 @@ pub struct Report {
     pub momentum_initial: [f64; 2],
     /// Total momentum at the end.
     pub momentum_final: [f64; 2],
+    /// Angular momentum about the origin at the start, `Σ (m x × v + I ω)`.
+    pub angular_momentum_initial: f64,
+    /// The same at the end.
+    pub angular_momentum_final: f64,
     /// Deepest overlap after any (sampled) step, as a fraction of the pair's smaller radius.
     pub max_penetration: f64,
     /// Mean overlap of the overlapping pairs seen after (sampled) steps, same units.
@@ -248,6 +261,8 @@ pub struct Report {
     pub final_penetration: f64,
     /// Kinetic energy at the end (what a pile that should have settled has left).
     pub kinetic_final: f64,
+    /// Energy of turning at the end, `Σ ½ I ω²` (in `energy_final`, not in `kinetic_final`).
+    pub rotational_final: f64,
     /// Centres outside the arena at the end.
     pub escaped: usize,
     /// Circles with a non-finite position or velocity at the end.
@@ -345,10 +360,13 @@ impl Report {
             energy_drift: relative_change(before.energy(), after.energy()),
             momentum_initial: before.momentum.to_array(),
             momentum_final: after.momentum.to_array(),
+            angular_momentum_initial: before.angular_momentum,
+            angular_momentum_final: after.angular_momentum,
             max_penetration: overlaps.max,
             mean_penetration: overlaps.mean(),
             final_penetration: final_overlaps.max,
             kinetic_final: after.kinetic_energy,
+            rotational_final: after.rotational_energy,
             escaped: after.escaped,
             non_finite: after.non_finite,
             pair_collisions: pairs.count,

@@ -57,13 +57,17 @@ fn a_resumed_run_ends_bit_for_bit_where_the_whole_run_ends_under_every_solver() 
     // heap under gravity, whose resting contacts `soft` warm starts across it and whose circles
     // come to rest and sleep across it under every solver that holds a heap; and the Galton
     // board: static pegs, segment walls, and balls of a given mass dropped on either side of
-    // each pause.
+    // each pause; balls that roll with friction (the reports' angular momentum holds their
+    // spin).
     let every = ["discrete", "substeps=4", "soft", "swept", "exact"];
     let runs = [
         ("assets/scenes/billiards.ron", &every[..]),
         ("assets/scenes/gas1k.ron", &every[..]),
         ("assets/scenes/gravity.ron", &["soft", "swept", "exact"][..]),
         ("assets/scenes/galton.ron", &every[..]),
+        // Friction: spin, and friction impulses warm started across each pause.
+        ("assets/scenes/slope.ron", &["soft", "exact"][..]),
+        ("assets/scenes/repose.ron", &["soft"][..]),
     ];
     for (scene, solvers) in runs {
         for &solver in solvers {

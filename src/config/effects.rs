@@ -1,6 +1,7 @@
-//! [`Effects`]: which effects a scene calls for and their parameters (restitution, gravity,
-//! drag, collision messages, sleeping), with the one `check` scenes and the command line use;
-//! and [`SleepConfig`], when circles at rest fall asleep.
+//! [`Effects`]: which effects a scene calls for and their parameters (restitution, friction,
+//! gravity, drag, collision messages, sleeping), with the one `check` scenes and the command
+//! line use; [`Combine`], how two circles' friction meets; and [`SleepConfig`], when circles
+//! at rest fall asleep.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -25,6 +26,21 @@ pub struct Effects {
     pub restitution: f64,
     /// Coefficient of restitution against the walls.
     pub wall_restitution: f64,
+    /// Coefficient of friction between circles (Coulomb's μ, 0 or more): a contact's push
+    /// along its surface is at most μ times its push along the normal. 0, the default, is
+    /// smooth. Friction acts under the contact solver `soft`, which then turns circles
+    /// ([`AngularVelocity`](crate::components::AngularVelocity)); the other solvers treat
+    /// circles as smooth.
+    pub friction: f64,
+    /// Coefficient of friction against arena walls and segment walls.
+    pub wall_friction: f64,
+    /// How two friction coefficients meet (a circle's own [`Friction`](crate::components::Friction)
+    /// and its partner's, or the walls'): their geometric mean by default.
+    pub friction_combine: Combine,
+    /// Rolling resistance (dimensionless, 0 or more): a rolling circle is slowed by a torque
+    /// of this times its contact's push times its radius (the smaller radius of two circles),
+    /// so a ball rolling on a floor stops after a while. Under `soft`, with friction.
+    pub rolling_resistance: f64,
     /// Write a [`CircleHit`](crate::hits::CircleHit) message per circle-circle impulse and a
     /// [`WallHit`](crate::hits::WallHit) per wall hit, under every solver. Off, nothing is
     /// recorded.
@@ -63,6 +79,47 @@ impl Default for SleepConfig {
     }
 }
 
+/// How two friction coefficients `a` and `b` meet at a contact. Each rule gives `a` when both
+/// are `a`, so circles that all take the scene's coefficient meet with exactly it.
+#[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Combine {
+    /// `√(a·b)` (Box2D's rule): a frictionless side makes the contact frictionless.
+    #[default]
+    GeometricMean,
+    /// `(a + b) / 2` (avian's default).
+    Average,
+    /// The smaller.
+    Min,
+    /// The larger.
+    Max,
+}
+
+impl Combine {
+    /// The coefficient of a contact between surfaces of coefficients `a` and `b`.
+    ///
+    /// ```
+    /// use moving_circles::config::Combine;
+    ///
+    /// assert_eq!(Combine::GeometricMean.apply(0.5, 0.5), 0.5);
+    /// assert_eq!(Combine::GeometricMean.apply(0.0, 0.9), 0.0);
+    /// assert_eq!(Combine::Max.apply(0.2, 0.6), 0.6);
+    /// ```
+    #[inline]
+    pub fn apply(self, a: f64, b: f64) -> f64 {
+        match self {
+            Combine::GeometricMean if a == b => a,
+            Combine::GeometricMean => (a * b).sqrt(),
+            Combine::Average => 0.5 * (a + b),
+            Combine::Min => a.min(b),
+            Combine::Max => a.max(b),
+        }
+    }
+}
+
+/// The largest friction coefficient or rolling resistance an input may give (μ = 1 already
+/// holds a ball on a 45° slope).
+pub const MAX_FRICTION: f64 = 100.0;
+
 impl Default for Effects {
     fn default() -> Self {
         Self {
@@ -71,6 +128,10 @@ impl Default for Effects {
             drag: None,
             restitution: 1.0,
             wall_restitution: 1.0,
+            friction: 0.0,
+            wall_friction: 0.0,
+            friction_combine: Combine::GeometricMean,
+            rolling_resistance: 0.0,
             hit_messages: false,
             sleep: SleepConfig::default(),
         }
@@ -78,8 +139,9 @@ impl Default for Effects {
 }
 
 impl Effects {
-    /// Whether every parameter is usable: restitutions in `[0, 1]`, finite gravity, a finite
-    /// non-negative drag rate.
+    /// Whether every parameter is usable: restitutions in `[0, 1]`, friction coefficients and
+    /// rolling resistance from 0 to [`MAX_FRICTION`], finite gravity, a finite non-negative
+    /// drag rate.
     pub fn check(&self) -> Result<(), FieldError> {
         let unit = |x: f64| x.is_finite() && (0.0..=1.0).contains(&x);
         if !unit(self.restitution) {
@@ -93,6 +155,17 @@ impl Effects {
                 "effects.wall_restitution",
                 format!("must be in [0, 1], got {}", self.wall_restitution),
             ));
+        }
+        let coefficients = [
+            ("effects.friction", self.friction),
+            ("effects.wall_friction", self.wall_friction),
+            ("effects.rolling_resistance", self.rolling_resistance),
+        ];
+        for (field, value) in coefficients {
+            if !(0.0..=MAX_FRICTION).contains(&value) {
+                let why = format!("must be from 0 to {MAX_FRICTION}, got {value}");
+                return Err(FieldError::new(field, why));
+            }
         }
         if let Some(g) = self.gravity {
             check_vector("effects.gravity", g)?;

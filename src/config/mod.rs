@@ -16,7 +16,7 @@ use crate::error::FieldError;
 pub use crate::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, check_vector};
 use crate::segment::Segments;
 pub use drop::DropConfig;
-pub use effects::{Effects, SleepConfig};
+pub use effects::{Combine, Effects, MAX_FRICTION, SleepConfig};
 pub use soft::SoftConfig;
 pub use spawn::{
     MAX_AREA_FRACTION, MAX_ATTEMPTS_PER_CIRCLE, MAX_PACK_CIRCLES, MIN_RADIUS_FRACTION, MassModel,

@@ -32,6 +32,7 @@ use crate::collide::PairCollisions;
 use crate::components::{Mass, Position, Radius, Restitution, Sleep, SolverCircles, Velocity};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
+use crate::integrate::turn_circles;
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
 use crate::segment::Segments;
 use crate::sleep::Sleeping;
@@ -213,6 +214,8 @@ fn continuous_step(
         messages,
     );
     write_back(&mut state, &mut circles.p0());
+    // Smooth circles trade no spin: each turns at its own constant rate.
+    turn_circles(&mut circles.p0(), dt.0);
     counted.sleeping.count = write_back_sleep(&state, &mut circles.p2());
 }
 
@@ -355,7 +358,7 @@ fn moved_since(
     }
     let mut moved = Vec::new();
     for &entity in changed {
-        let (Some(&i), Ok((_, p, v, r, m, e, _))) = (index.get(&entity), circles.get(entity))
+        let (Some(&i), Ok((_, p, v, r, m, e, ..))) = (index.get(&entity), circles.get(entity))
         else {
             return Err("circles were spawned or despawned");
         };

@@ -18,7 +18,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
-use crate::components::{Mass, Position, Radius, Sleep, Velocity};
+use crate::components::{AngularVelocity, Mass, Position, Radius, Sleep, Velocity};
 use crate::config::{Effects, SleepConfig, Solver};
 use crate::effects::{Effect, register_effect};
 use crate::schedule::{CircleSystems, StepTotals};
@@ -122,6 +122,7 @@ type SleepingCircles<'w, 's> = Query<
         Ref<'static, Radius>,
         Ref<'static, Mass>,
         &'static mut Sleep,
+        Option<Mut<'static, AngularVelocity>>,
     ),
 >;
 
@@ -147,18 +148,24 @@ fn update_sleep(
     let (resting, islands) = &mut *scratch;
     resting.clear();
     let (mut stirring, mut asleep, mut ready) = (false, 0usize, false);
-    for (position, velocity, radius, mass, mut sleep) in &mut circles {
+    for (position, velocity, radius, mass, mut sleep, spin) in &mut circles {
         let movable = !mass.is_immovable();
         let moved = |changed: bool, added: bool| changed && !added;
+        let spun = spin
+            .as_ref()
+            .is_some_and(|w| moved(w.is_changed(), w.is_added()));
         if sleep.asleep
             && (moved(position.is_changed(), position.is_added())
                 || moved(velocity.is_changed(), velocity.is_added())
                 || moved(radius.is_changed(), radius.is_added())
-                || moved(mass.is_changed(), mass.is_added()))
+                || moved(mass.is_changed(), mass.is_added())
+                || spun)
         {
             *sleep = Sleep::default();
         }
-        let pushing = !movable && velocity.0 != DVec2::ZERO;
+        // An immovable circle that moves or turns (a paddle, a wheel) drives what it touches.
+        let turning = spin.as_ref().is_some_and(|w| w.0 != 0.0);
+        let pushing = !movable && (velocity.0 != DVec2::ZERO || turning);
         if movable && !sleep.asleep {
             rest(&mut sleep, &config, position.0, radius.0, dt);
             ready |= sleep.slow_for >= config.time;
@@ -182,11 +189,17 @@ fn update_sleep(
         changed |= !fall_asleep(resting, &arena, config.time, islands).is_empty();
     }
     if changed {
-        for (i, (_, mut velocity, _, _, mut sleep)) in circles.iter_mut().enumerate() {
+        for (i, (_, mut velocity, _, _, mut sleep, spin)) in circles.iter_mut().enumerate() {
             if *sleep != resting[i].sleep {
                 *sleep = resting[i].sleep;
                 if sleep.asleep && velocity.0 != DVec2::ZERO {
                     velocity.0 = DVec2::ZERO;
+                }
+                if let Some(mut spin) = spin
+                    && sleep.asleep
+                    && spin.0 != 0.0
+                {
+                    spin.0 = 0.0;
                 }
             }
         }

@@ -16,8 +16,18 @@ pub struct Bodies {
     pub radius: Vec<f64>,
     /// Inverse masses: 0 for an immovable (static or kinematic) circle.
     pub inv_mass: Vec<f64>,
+    /// Angular velocities (counter-clockwise, radians per second).
+    pub angular_velocity: Vec<f64>,
+    /// Rotations (radians, in `[-π, π]`).
+    pub rotation: Vec<f64>,
+    /// Inverse moments of inertia: `2 / (m r²)` for a uniform disc, 0 for a circle that
+    /// cannot turn (immovable, asleep, or without an angular velocity).
+    pub inv_inertia: Vec<f64>,
     /// Each circle's own restitution, or empty when every circle takes the scene's.
     pub restitution: Vec<f64>,
+    /// Each circle's own friction coefficient (NaN for one without), or empty when every
+    /// circle takes the scene's.
+    pub friction: Vec<f64>,
     /// A stable identity per circle (its entity), so a contact is recognised next step.
     pub id: Vec<u64>,
 }
@@ -29,17 +39,34 @@ impl Bodies {
         self.velocity.clear();
         self.radius.clear();
         self.inv_mass.clear();
+        self.angular_velocity.clear();
+        self.rotation.clear();
+        self.inv_inertia.clear();
         self.restitution.clear();
+        self.friction.clear();
         self.id.clear();
     }
 
-    /// Adds a circle.
+    /// Adds a circle that does not turn.
     pub fn push(&mut self, id: u64, position: DVec2, velocity: DVec2, radius: f64, inv_mass: f64) {
         self.id.push(id);
         self.position.push(position);
         self.velocity.push(velocity);
         self.radius.push(radius);
         self.inv_mass.push(inv_mass);
+        self.angular_velocity.push(0.0);
+        self.rotation.push(0.0);
+        self.inv_inertia.push(0.0);
+    }
+
+    /// Lets the circle added last turn: at `angular_velocity`, from `rotation`, as a uniform
+    /// disc (moment of inertia `m r² / 2`) if it is movable.
+    pub fn turning(&mut self, angular_velocity: f64, rotation: f64) {
+        let i = self.len() - 1;
+        self.angular_velocity[i] = angular_velocity;
+        self.rotation[i] = rotation;
+        let r = self.radius[i];
+        self.inv_inertia[i] = 2.0 * self.inv_mass[i] / (r * r);
     }
 
     /// Number of circles.
@@ -56,6 +83,12 @@ impl Bodies {
     #[inline]
     pub fn restitution_of(&self, i: usize, scene: f64) -> f64 {
         self.restitution.get(i).copied().unwrap_or(scene)
+    }
+
+    /// Circle `i`'s own friction coefficient, if it has one.
+    #[inline]
+    pub fn own_friction(&self, i: usize) -> Option<f64> {
+        self.friction.get(i).copied().filter(|f| !f.is_nan())
     }
 }
 

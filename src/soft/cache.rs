@@ -1,4 +1,5 @@
-//! The [`ContactCache`]: each contact's impulse at the end of a step, kept under its circle's
+//! The [`ContactCache`]: each contact's impulses at the end of a step (along the normal, along
+//! the surface and in turning), kept under its circle's
 //! identity and its partner, so the next step starts from last step's answer (warm starting)
 //! and knows which contacts were already pushing (those do not bounce again); and
 //! [`CacheSnapshot`], the same as plain data for a checkpoint.
@@ -23,6 +24,8 @@ struct Cached {
     partner: Partner,
     impulse: f64,
     touching: bool,
+    tangent: f64,
+    rolling: f64,
 }
 
 /// The impulses of last step's contacts, by circle: what warm starting starts from.
@@ -73,6 +76,8 @@ impl ContactCache {
             {
                 c.impulse = hit.impulse;
                 c.was_touching = hit.touching;
+                c.tangent_impulse = hit.tangent;
+                c.rolling_impulse = hit.rolling;
             }
         }
     }
@@ -105,7 +110,13 @@ impl ContactCache {
                         Partner::Circle(id) => SnapshotPartner::Circle(*position.get(&id)?),
                         Partner::Wall(wall) => SnapshotPartner::Wall(wall),
                     };
-                    Some((partner, e.impulse, e.touching))
+                    Some(CachedContact {
+                        partner,
+                        impulse: e.impulse,
+                        touching: e.touching,
+                        tangent: e.tangent,
+                        rolling: e.rolling,
+                    })
                 }));
             }
             snapshot
@@ -127,13 +138,15 @@ impl ContactCache {
         let entries = snapshot
             .entries
             .iter()
-            .map(|&(partner, impulse, touching)| Cached {
-                partner: match partner {
+            .map(|e| Cached {
+                partner: match e.partner {
                     SnapshotPartner::Circle(k) => Partner::Circle(ids[k as usize]),
                     SnapshotPartner::Wall(wall) => Partner::Wall(wall),
                 },
-                impulse,
-                touching,
+                impulse: e.impulse,
+                touching: e.touching,
+                tangent: e.tangent,
+                rolling: e.rolling,
             })
             .collect();
         Ok(Self {
@@ -168,6 +181,8 @@ impl ContactCache {
             partner: Partner::Wall(Wall::Segment(0)),
             impulse: 0.0,
             touching: false,
+            tangent: 0.0,
+            rolling: 0.0,
         };
         self.entries.clear();
         self.entries.resize(self.start[ids.len()] as usize, empty);
@@ -177,6 +192,8 @@ impl ContactCache {
                 partner: c.partner,
                 impulse: c.impulse,
                 touching: c.total_impulse > 0.0,
+                tangent: c.tangent_impulse,
+                rolling: c.rolling_impulse,
             };
             *slot += 1;
         }
@@ -192,12 +209,26 @@ pub enum SnapshotPartner {
     Wall(Wall),
 }
 
+/// One contact in a [`CacheSnapshot`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct CachedContact {
+    partner: SnapshotPartner,
+    /// Impulse along the normal.
+    impulse: f64,
+    /// Whether it pushed.
+    touching: bool,
+    /// Impulse along the surface (friction).
+    tangent: f64,
+    /// Torque impulse (rolling resistance).
+    rolling: f64,
+}
+
 /// [`ContactCache`] as plain data for a checkpoint: how many contacts each circle has (as
-/// their first circle), and each contact's partner, impulse and whether it pushed.
+/// their first circle), and each contact's partner, impulses and whether it pushed.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CacheSnapshot {
     counts: Vec<u32>,
-    entries: Vec<(SnapshotPartner, f64, bool)>,
+    entries: Vec<CachedContact>,
 }
 
 impl CacheSnapshot {
@@ -211,16 +242,29 @@ impl CacheSnapshot {
             .iter()
             .enumerate()
             .flat_map(|(i, &count)| std::iter::repeat_n(i, count as usize));
-        for (i, &(partner, impulse, _)) in owners.zip(&self.entries) {
-            let other = match partner {
-                SnapshotPartner::Circle(k) => circles[k as usize].inv_mass(),
-                SnapshotPartner::Wall(_) => 0.0,
+        for (i, e) in owners.zip(&self.entries) {
+            let other = match e.partner {
+                SnapshotPartner::Circle(k) => &circles[k as usize],
+                SnapshotPartner::Wall(_) => &circles[i],
             };
-            let lightest = circles[i].inv_mass().max(other);
-            if impulse * lightest > MOST_SPEED_CHANGES * MAX_MAGNITUDE {
-                return Err(format!(
-                    "a cached contact impulse of {impulse:e} on circle {i} is beyond any speed"
-                ));
+            let lightest = circles[i].inv_mass().max(match e.partner {
+                SnapshotPartner::Circle(_) => other.inv_mass(),
+                SnapshotPartner::Wall(_) => 0.0,
+            });
+            // A torque impulse k turns a uniform disc's surface by 2 k w / r.
+            let smaller = circles[i].radius.min(other.radius);
+            let turning = 2.0 * e.rolling.abs() * lightest / smaller;
+            for (what, change) in [
+                ("contact impulse", e.impulse * lightest),
+                ("friction impulse", e.tangent.abs() * lightest),
+                ("rolling impulse", turning),
+            ] {
+                if change > MOST_SPEED_CHANGES * MAX_MAGNITUDE {
+                    return Err(format!(
+                        "a cached {what} on circle {i} is beyond any speed: it would change \
+                         a speed by {change:e}"
+                    ));
+                }
             }
         }
         Ok(())
@@ -239,14 +283,18 @@ impl CacheSnapshot {
         if total != self.entries.len() as u64 {
             return Err("the contact cache's lists do not add up".to_owned());
         }
-        for &(partner, impulse, _) in &self.entries {
-            if let SnapshotPartner::Circle(k) = partner
+        for e in &self.entries {
+            if let SnapshotPartner::Circle(k) = e.partner
                 && k as usize >= n
             {
                 return Err(format!("a cached contact names circle {k} of {n}"));
             }
-            if !(impulse.is_finite() && impulse >= 0.0) {
-                return Err(format!("a cached contact impulse is {impulse}"));
+            if !(e.impulse.is_finite() && e.impulse >= 0.0) {
+                return Err(format!("a cached contact impulse is {}", e.impulse));
+            }
+            if !(e.tangent.is_finite() && e.rolling.is_finite()) {
+                let (t, r) = (e.tangent, e.rolling);
+                return Err(format!("a cached friction impulse is {t}, rolling {r}"));
             }
         }
         Ok(())
@@ -254,7 +302,7 @@ impl CacheSnapshot {
 
     /// The segment walls the cached contacts name.
     pub fn segments(&self) -> impl Iterator<Item = u32> + '_ {
-        self.entries.iter().filter_map(|e| match e.0 {
+        self.entries.iter().filter_map(|e| match e.partner {
             SnapshotPartner::Wall(Wall::Segment(k)) => Some(k),
             _ => None,
         })
@@ -273,19 +321,40 @@ mod tests {
         // impulse of 2.6e307 sent them to infinity on the warm start).
         let light = |x| CircleState::new(DVec2::new(x, 0.0), DVec2::ZERO, 0.1).with_mass(0.03);
         let circles = [light(0.0), light(0.2)];
-        let cache = |impulse| CacheSnapshot {
-            counts: vec![1, 0],
-            entries: vec![(SnapshotPartner::Circle(1), impulse, true)],
+        let contact = |partner, impulse, tangent, rolling| CachedContact {
+            partner,
+            impulse,
+            touching: true,
+            tangent,
+            rolling,
         };
-        assert!(cache(0.5).check(&circles).is_ok());
-        assert!(cache(1e28).check(&circles).is_ok());
+        let cache = |impulse, tangent, rolling| CacheSnapshot {
+            counts: vec![1, 0],
+            entries: vec![contact(
+                SnapshotPartner::Circle(1),
+                impulse,
+                tangent,
+                rolling,
+            )],
+        };
+        assert!(cache(0.5, -0.2, 0.01).check(&circles).is_ok());
+        assert!(cache(1e28, -1e28, 1e26).check(&circles).is_ok());
         for forged in [2.6e307, 1e30, -1.0, f64::NAN] {
-            assert!(cache(forged).check(&circles).is_err(), "{forged} accepted");
+            assert!(cache(forged, 0.0, 0.0).check(&circles).is_err(), "{forged}");
+        }
+        for forged in [-2.6e307, 1e30, f64::NAN, f64::INFINITY] {
+            assert!(cache(0.5, forged, 0.0).check(&circles).is_err(), "{forged}");
+            assert!(cache(0.5, 0.0, forged).check(&circles).is_err(), "{forged}");
         }
         // Against a wall only the circle's own mass counts; an immovable circle takes none.
         let wall = CacheSnapshot {
             counts: vec![1, 0],
-            entries: vec![(SnapshotPartner::Wall(Wall::Segment(0)), 1e30, true)],
+            entries: vec![contact(
+                SnapshotPartner::Wall(Wall::Segment(0)),
+                1e30,
+                0.0,
+                0.0,
+            )],
         };
         assert!(wall.check(&circles).is_err());
         let pegs = [circles[0].with_mass(f64::INFINITY), circles[1]];

@@ -9,6 +9,7 @@ use super::bodies::{Bodies, Softness};
 use crate::arena::Arena;
 use crate::collide::broad_phase::{CellList, overlapping_pairs};
 use crate::collide::contact::{combine_restitution, contact_normal};
+use crate::config::Combine;
 use crate::exact::toi::pair_time_of_impact;
 use crate::grid::NONE;
 use crate::hits::{ArenaWall, Wall};
@@ -68,6 +69,22 @@ pub struct Constraint {
     pub approach: f64,
     /// Whether the contact pushed in the last step (a new push is a collision to count).
     pub was_touching: bool,
+    /// Coefficient of friction of the pair (0: smooth, no tangent row).
+    pub friction: f64,
+    /// Rolling resistance times the lever it acts on: the most torque per unit of normal push.
+    pub rolling: f64,
+    /// Distances from `a`'s and `b`'s centres to the contact point (`b`'s 0 for a wall).
+    pub lever: (f64, f64),
+    /// Inverse moments of inertia of the two sides (0 for a side that cannot turn).
+    pub inv_inertia: (f64, f64),
+    /// `1 / (w_a + w_b + i_a r_a² + i_b r_b²)`: the mass the tangent row moves.
+    pub tangent_mass: f64,
+    /// `1 / (i_a + i_b)`, or 0 if neither side turns: the inertia the rolling row turns.
+    pub rolling_mass: f64,
+    /// Tangent impulse accumulated in the current substep (warm started like `impulse`).
+    pub tangent_impulse: f64,
+    /// Rolling (torque) impulse accumulated in the current substep.
+    pub rolling_impulse: f64,
 }
 
 impl Constraint {
@@ -96,6 +113,37 @@ pub struct ContactRules {
     pub threshold: f64,
     /// Whether circles collide with each other at all.
     pub collisions: bool,
+    /// Friction between circles and against walls, for circles without their own.
+    pub friction: (f64, f64),
+    /// How two friction coefficients meet.
+    pub combine: Combine,
+    /// Rolling resistance (dimensionless).
+    pub rolling_resistance: f64,
+}
+
+/// The tangent and rolling rows of a contact between sides of inverse masses `w`, inverse
+/// inertias `i`, at distances `lever` from the contact point, with friction `friction` and a
+/// rolling torque per unit of push of `rolling`: the fields a [`Constraint`] ends with, none
+/// turning when there is no friction.
+fn turning_rows(
+    w: (f64, f64),
+    i: (f64, f64),
+    lever: (f64, f64),
+    friction: f64,
+    rolling: f64,
+) -> (f64, f64, f64, f64) {
+    if friction == 0.0 {
+        return (0.0, 0.0, 0.0, 0.0);
+    }
+    let k = w.0 + w.1 + i.0 * lever.0 * lever.0 + i.1 * lever.1 * lever.1;
+    let spin = i.0 + i.1;
+    let rolling_mass = if spin > 0.0 && rolling > 0.0 {
+        1.0 / spin
+    } else {
+        0.0
+    };
+    let rolling = if rolling_mass > 0.0 { rolling } else { 0.0 };
+    (friction, rolling, 1.0 / k, rolling_mass)
 }
 
 /// Reusable buffers of contact finding.
@@ -241,6 +289,17 @@ fn pair_contact(
         bodies.restitution_of(i, rules.restitution.0),
         bodies.restitution_of(j, rules.restitution.0),
     );
+    let lever = (bodies.radius[i], bodies.radius[j]);
+    let (friction, rolling, tangent_mass, rolling_mass) = turning_rows(
+        (wa, wb),
+        (bodies.inv_inertia[i], bodies.inv_inertia[j]),
+        lever,
+        rules.combine.apply(
+            bodies.own_friction(i).unwrap_or(rules.friction.0),
+            bodies.own_friction(j).unwrap_or(rules.friction.0),
+        ),
+        rules.rolling_resistance * smaller,
+    );
     Some(Constraint {
         a: i as u32,
         b: j as u32,
@@ -263,6 +322,14 @@ fn pair_contact(
         total_impulse: 0.0,
         approach: 0.0,
         was_touching: false,
+        friction,
+        rolling,
+        lever,
+        inv_inertia: (bodies.inv_inertia[i], bodies.inv_inertia[j]),
+        tangent_mass,
+        rolling_mass,
+        tangent_impulse: 0.0,
+        rolling_impulse: 0.0,
     })
 }
 
@@ -278,6 +345,19 @@ fn wall_contact(
 ) -> Constraint {
     let (r, w) = (bodies.radius[i], bodies.inv_mass[i]);
     let own = bodies.restitution_of(i, rules.restitution.1);
+    // The walls' coefficient is that of a circle against them; a circle's own meets it.
+    let walls = rules.friction.1;
+    let friction = bodies
+        .own_friction(i)
+        .map_or(walls, |own| rules.combine.apply(own, walls));
+    let inertia = bodies.inv_inertia[i];
+    let (friction, rolling, tangent_mass, rolling_mass) = turning_rows(
+        (w, 0.0),
+        (inertia, 0.0),
+        (r, 0.0),
+        friction,
+        rules.rolling_resistance * r,
+    );
     Constraint {
         a: i as u32,
         b: NONE,
@@ -296,5 +376,13 @@ fn wall_contact(
         total_impulse: 0.0,
         approach: 0.0,
         was_touching: false,
+        friction,
+        rolling,
+        lever: (r, 0.0),
+        inv_inertia: (inertia, 0.0),
+        tangent_mass,
+        rolling_mass,
+        tangent_impulse: 0.0,
+        rolling_impulse: 0.0,
     }
 }

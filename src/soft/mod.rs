@@ -14,6 +14,7 @@
 pub mod bodies;
 pub mod cache;
 pub mod contacts;
+pub mod friction;
 pub mod solve;
 
 use bevy::ecs::system::SystemParam;
@@ -23,7 +24,7 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
-use crate::components::{Restitution, SolverCircles};
+use crate::components::{Friction, Restitution, SolverCircles};
 use crate::config::{Effects, SoftConfig, Solver};
 use crate::hits::{CircleHit, HitLog, WallHit};
 use crate::schedule::{CircleSystems, SoftStep, StepDt};
@@ -43,6 +44,7 @@ impl Plugin for SoftPlugin {
             .init_resource::<SoftConfig>()
             .init_resource::<PairCollisions>()
             .init_resource::<WallCollisions>()
+            .register_type::<Friction>()
             .add_message::<CircleHit>()
             .add_message::<WallHit>()
             .add_systems(SoftStep, step_soft.in_set(CircleSystems::Soft));
@@ -112,7 +114,7 @@ struct SoftSetup<'w> {
 fn step_soft(
     setup: SoftSetup,
     mut state: ResMut<SoftState>,
-    own_restitution: Query<(), With<Restitution>>,
+    own: (Query<(), With<Restitution>>, Query<(), With<Friction>>),
     counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
     mut circles: SolverCircles,
@@ -134,21 +136,33 @@ fn step_soft(
         log,
         last,
     } = &mut *state;
-    let per_circle = !own_restitution.is_empty();
+    let per_circle = (!own.0.is_empty(), !own.1.is_empty());
     bodies.clear();
     entities.clear();
-    for (entity, p, v, r, m, own, sleep) in &circles {
+    for (entity, p, v, r, m, restitution, sleep, (spin, rotation, friction)) in &circles {
         // A sleeping circle is an immovable circle at rest until it is woken.
         let inverse = if sleep.asleep { 0.0 } else { m.inverse() };
         bodies.push(entity.to_bits(), p.0, v.0, r.0, inverse);
-        if per_circle {
+        if let (Some(spin), Some(rotation)) = (spin, rotation) {
+            bodies.turning(spin.0, rotation.0);
+        }
+        if per_circle.0 {
             let scene = effects.restitution;
-            bodies.restitution.push(own.map_or(scene, |own| own.0));
+            bodies
+                .restitution
+                .push(restitution.map_or(scene, |own| own.0));
+        }
+        if per_circle.1 {
+            bodies.friction.push(friction.map_or(f64::NAN, |own| own.0));
         }
         entities.push(entity);
     }
     // Everything asleep or static: nothing can move this step.
-    let moving = |i: usize| bodies.inv_mass[i] > 0.0 || bodies.velocity[i] != DVec2::ZERO;
+    let moving = |i: usize| {
+        bodies.inv_mass[i] > 0.0
+            || bodies.velocity[i] != DVec2::ZERO
+            || bodies.angular_velocity[i] != 0.0
+    };
     if !(0..bodies.len()).any(moving) {
         *last = SoftStats::default();
         return;
@@ -160,6 +174,9 @@ fn step_soft(
         drag: effects.drag.unwrap_or(0.0),
         restitution: (effects.restitution, effects.wall_restitution),
         collisions: effects.collisions,
+        friction: (effects.friction, effects.wall_friction),
+        combine: effects.friction_combine,
+        rolling_resistance: effects.rolling_resistance,
         config: *config,
     };
     let cells = segment_cells(kept_cells, &arena, &segments);
@@ -185,13 +202,22 @@ fn step_soft(
         log.send_circle_hits(|i| entities[i as usize], 0.0, &mut messages.0);
         log.send_wall_hits(|i| entities[i as usize], 0.0, &mut messages.1);
     }
-    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
+    for (i, (_, mut p, mut v, .., (spin, rotation, _))) in circles.iter_mut().enumerate() {
         let (position, velocity) = (bodies.position[i], bodies.velocity[i]);
         if p.0 != position {
             p.0 = position;
         }
         if v.0 != velocity {
             v.0 = velocity;
+        }
+        if let (Some(mut spin), Some(mut rotation)) = (spin, rotation) {
+            let (w, angle) = (bodies.angular_velocity[i], bodies.rotation[i]);
+            if spin.0 != w {
+                spin.0 = w;
+            }
+            if rotation.0 != angle {
+                rotation.0 = angle;
+            }
         }
     }
 }

@@ -1,9 +1,10 @@
 //! One `soft` step as plain functions over [`Bodies`], stage by stage as in Box2D v3's soft
 //! step: find the contacts and warm start them from the last step ([`find_contacts`],
 //! [`ContactCache`]); then per substep integrate velocities (gravity, drag), apply the warm
-//! start, solve the contacts with their soft bias, integrate positions and relax (solve again
-//! without the bias, so the push-out leaves no velocity behind); once after the substeps, the
-//! restitution pass; last, store the impulses for the next step.
+//! start, solve the contacts with their soft bias (and their friction, [`super::friction`]),
+//! integrate positions and rotations and relax (solve again without the bias, so the push-out
+//! leaves no velocity behind); once after the substeps, the restitution pass; last, store the
+//! impulses for the next step.
 //!
 //! Contacts are solved one after another in a fixed order (Gauss-Seidel; arena and segment
 //! walls first, then pairs in the broad phase's order), so a step is the same on any number of
@@ -14,9 +15,10 @@ use bevy::math::DVec2;
 use super::bodies::{Bodies, Softness};
 use super::cache::ContactCache;
 use super::contacts::{Constraint, ContactRules, ContactScratch, Partner, find_contacts};
+use super::friction::{solve_turning, turn, warm_start_turning};
 use crate::arena::Arena;
 use crate::boundary::put_back_inside;
-use crate::config::SoftConfig;
+use crate::config::{Combine, SoftConfig};
 use crate::grid::NONE;
 use crate::hits::{CircleHit, HitLog, WallHit};
 use crate::segment::{Segment, SegmentCells};
@@ -36,6 +38,12 @@ pub struct SoftParams {
     pub restitution: (f64, f64),
     /// Whether circles collide with each other.
     pub collisions: bool,
+    /// Friction between circles, and against walls, for circles without their own.
+    pub friction: (f64, f64),
+    /// How two friction coefficients meet.
+    pub combine: Combine,
+    /// Rolling resistance (dimensionless).
+    pub rolling_resistance: f64,
     /// The contacts' tuning.
     pub config: SoftConfig,
 }
@@ -180,6 +188,9 @@ fn soft_part(
         push_speed: params.config.push_speed,
         threshold: params.config.restitution_threshold,
         collisions: params.collisions,
+        friction: params.friction,
+        combine: params.combine,
+        rolling_resistance: params.rolling_resistance,
     };
     let SoftScratch {
         contacts,
@@ -196,6 +207,7 @@ fn soft_part(
         warm_start(bodies, walls, pairs, &mut work);
         solve(bodies, (walls, pairs), inv_h, true, &mut work);
         integrate_positions(bodies, h);
+        turn(bodies, h);
         solve(bodies, (walls, pairs), inv_h, false, &mut work);
     }
     restitution(bodies, (walls, pairs), &mut work);
@@ -217,6 +229,13 @@ fn soft_part(
 struct Work {
     energy: f64,
     momentum: DVec2,
+}
+
+impl Work {
+    fn add(&mut self, (energy, momentum): (f64, DVec2)) {
+        self.energy += energy;
+        self.momentum += momentum;
+    }
 }
 
 /// Gravity and drag for every movable circle, over one substep.
@@ -270,6 +289,9 @@ fn warm_start(
             apply(bodies, c, c.impulse, work);
             c.total_impulse += c.impulse;
         }
+        if c.friction > 0.0 {
+            work.add(warm_start_turning(bodies, c));
+        }
     }
 }
 
@@ -315,6 +337,9 @@ fn solve(
         c.impulse = total;
         c.total_impulse += j;
         apply(bodies, c, j, work);
+        if c.friction > 0.0 {
+            work.add(solve_turning(bodies, c));
+        }
     }
 }
 
