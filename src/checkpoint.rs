@@ -5,6 +5,7 @@
 //! a compact binary form (postcard); read back with a size limit and every value checked, so a
 //! damaged or forged file is an error naming the file, never a panic.
 
+use std::f64::consts::PI;
 use std::path::Path;
 
 use bevy::prelude::*;
@@ -14,7 +15,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
-use crate::components::{AngularVelocity, Rotation, Sleep};
+use crate::components::Sleep;
 use crate::config::{
     CirclesConfig, DropConfig, Effects, MAX_CIRCLES, MassModel, SoftConfig, Solver, SpawnConfig,
     min_radius,
@@ -57,8 +58,6 @@ pub struct Checkpoint {
     circles: Vec<CircleState>,
     /// Each circle's sleep, in the order of `circles`.
     sleep: Vec<Sleep>,
-    /// Each circle's rotation and angular velocity, in the order of `circles`.
-    spin: Vec<(f64, f64)>,
     steps: StepTotals,
     pairs: PairCollisions,
     walls: WallCollisions,
@@ -99,16 +98,6 @@ impl Checkpoint {
             sleep: entities
                 .iter()
                 .map(|&e| world.get::<Sleep>(e).copied().unwrap_or_default())
-                .collect(),
-            spin: entities
-                .iter()
-                .map(|&e| {
-                    let rotation = world.get::<Rotation>(e).map_or(0.0, |r| r.0);
-                    (
-                        rotation,
-                        world.get::<AngularVelocity>(e).map_or(0.0, |w| w.0),
-                    )
-                })
                 .collect(),
             steps: *world.resource::<StepTotals>(),
             pairs: *world.resource::<PairCollisions>(),
@@ -212,22 +201,6 @@ impl Checkpoint {
                 self.circles.len()
             ));
         }
-        if self.spin.len() != self.circles.len() {
-            return Err(format!(
-                "holds the spin of {} circles for {}",
-                self.spin.len(),
-                self.circles.len()
-            ));
-        }
-        // A rotation is kept in [-π, π]; a surface may turn no faster than any speed.
-        let pi = std::f64::consts::PI;
-        for (i, (&(angle, w), c)) in self.spin.iter().zip(&self.circles).enumerate() {
-            if !(-pi..=pi).contains(&angle) || check_magnitude("", w * c.radius).is_err() {
-                return Err(format!(
-                    "circle {i} has rotation {angle:?}, angular velocity {w:?}"
-                ));
-            }
-        }
         if let Some(i) = self
             .sleep
             .iter()
@@ -255,6 +228,13 @@ impl Checkpoint {
                 return Err(format!(
                     "circle {i} has an impossible radius {:?}",
                     c.radius
+                ));
+            }
+            // A rotation is kept in [-π, π]; a surface may turn no faster than any speed.
+            let (angle, w) = (c.rotation, c.angular_velocity);
+            if !(-PI..=PI).contains(&angle) || check_magnitude("", w * c.radius).is_err() {
+                return Err(format!(
+                    "circle {i} has rotation {angle:?}, angular velocity {w:?}"
                 ));
             }
             // Every step ends with each centre inside (put back or wrapped): one outside means
@@ -349,16 +329,9 @@ impl Checkpoint {
                 "its circles did not come back as they were written",
             ));
         }
-        for ((&(entity, _), &sleep), &(angle, w)) in circles.iter().zip(&self.sleep).zip(&self.spin)
-        {
+        for (&(entity, _), &sleep) in circles.iter().zip(&self.sleep) {
             if let Some(mut kept) = world.get_mut::<Sleep>(entity) {
                 *kept = sleep;
-            }
-            if let Some(mut rotation) = world.get_mut::<Rotation>(entity) {
-                rotation.0 = angle;
-            }
-            if let Some(mut spin) = world.get_mut::<AngularVelocity>(entity) {
-                spin.0 = w;
             }
         }
         world.resource_mut::<Sleeping>().count = self.sleep.iter().filter(|s| s.asleep).count();

@@ -5,7 +5,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Mass, Position, Radius, Tint, Velocity};
+use crate::components::{AngularVelocity, Mass, Position, Radius, Rotation, Tint, Velocity};
 
 /// The state of one circle.
 ///
@@ -28,6 +28,10 @@ pub struct CircleState {
     pub mass: f64,
     /// Colour as sRGB bytes.
     pub tint: [u8; 3],
+    /// Angular velocity (radians per second, counter-clockwise).
+    pub angular_velocity: f64,
+    /// How far it has turned (radians, in `[-π, π]`).
+    pub rotation: f64,
 }
 
 impl CircleState {
@@ -39,6 +43,16 @@ impl CircleState {
             radius,
             mass: 1.0,
             tint: Tint::default().0,
+            angular_velocity: 0.0,
+            rotation: 0.0,
+        }
+    }
+
+    /// The same circle turning at `angular_velocity`.
+    pub fn with_spin(self, angular_velocity: f64) -> Self {
+        Self {
+            angular_velocity,
+            ..self
         }
     }
 
@@ -54,42 +68,70 @@ impl CircleState {
     }
 
     /// The components of this circle, ready to spawn.
-    pub fn bundle(&self) -> (Radius, Position, Velocity, Mass, Tint) {
+    pub fn bundle(
+        &self,
+    ) -> (
+        Radius,
+        Position,
+        Velocity,
+        Mass,
+        Tint,
+        AngularVelocity,
+        Rotation,
+    ) {
         (
             Radius(self.radius),
             Position(self.position),
             Velocity(self.velocity),
             Mass(self.mass),
             Tint(self.tint),
+            AngularVelocity(self.angular_velocity),
+            Rotation(self.rotation),
         )
     }
 }
 
+/// What a circle is made of, as [`snapshot`] reads it (a circle without spin components
+/// does not turn).
+type Parts = (
+    &'static Position,
+    &'static Velocity,
+    &'static Radius,
+    &'static Mass,
+    &'static Tint,
+    Option<&'static AngularVelocity>,
+    Option<&'static Rotation>,
+);
+
 /// Every circle in the world, in query order (the order they were spawned in).
 pub fn snapshot(world: &mut World) -> Vec<CircleState> {
     world
-        .query::<(&Position, &Velocity, &Radius, &Mass, &Tint)>()
+        .query::<Parts>()
         .iter(world)
-        .map(|(p, v, r, m, t)| from_components(p, v, r, m, t))
+        .map(from_components)
         .collect()
 }
 
 /// [`snapshot`] with each circle's entity.
 pub fn snapshot_with_entities(world: &mut World) -> Vec<(Entity, CircleState)> {
     world
-        .query::<(Entity, &Position, &Velocity, &Radius, &Mass, &Tint)>()
+        .query::<(Entity, Parts)>()
         .iter(world)
-        .map(|(e, p, v, r, m, t)| (e, from_components(p, v, r, m, t)))
+        .map(|(e, parts)| (e, from_components(parts)))
         .collect()
 }
 
-fn from_components(p: &Position, v: &Velocity, r: &Radius, m: &Mass, t: &Tint) -> CircleState {
+fn from_components(
+    (p, v, r, m, t, w, a): bevy::ecs::query::QueryItem<'_, '_, Parts>,
+) -> CircleState {
     CircleState {
         position: p.0,
         velocity: v.0,
         radius: r.0,
         mass: m.0,
         tint: t.0,
+        angular_velocity: w.map_or(0.0, |w| w.0),
+        rotation: a.map_or(0.0, |a| a.0),
     }
 }
 

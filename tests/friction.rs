@@ -313,3 +313,27 @@ fn the_slope_scene_rolls_its_balls_down_turning_and_puts_them_to_sleep() {
     step(&mut app, 60 * 20);
     assert_eq!(app.world().resource::<Sleeping>().count, 4);
 }
+
+#[test]
+fn a_spinning_ball_dropped_on_the_floor_bounces_off_the_way_its_spin_throws_it() {
+    let mut app = scene("spin.ron");
+    let balls: Vec<Entity> = app
+        .world_mut()
+        .query_filtered::<Entity, With<Radius>>()
+        .iter(app.world())
+        .collect();
+    // 4.1 m to fall: the floor is hit after about 0.9 s.
+    step(&mut app, 70);
+    let vx: Vec<f64> = balls.iter().map(|&b| state(&app, b).1.x).collect();
+    let w: Vec<f64> = balls.iter().map(|&b| spin(&app, b)).collect();
+    assert!(vx[0] < -0.5 && vx[2] > 0.5, "{vx:?}");
+    assert_eq!(vx[1], 0.0, "the ball without spin bounced sideways");
+    // Friction took spin away: the spinning balls turn slower than at first.
+    assert!(
+        w[0] > 0.0 && w[0] < 30.0 && w[2] < 0.0 && w[2] > -30.0,
+        "{w:?}"
+    );
+    assert_eq!(w[1], 0.0);
+    // Mirror images: the same speeds, opposite directions.
+    assert!((vx[0] + vx[2]).abs() < 1e-9 && (w[0] + w[2]).abs() < 1e-9);
+}

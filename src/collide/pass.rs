@@ -118,12 +118,8 @@ pub fn resolve_all_contacts(
         cells.order()
     };
     let mut stats = PassStats::default();
-    let circle = |(position, radius): (DVec2, f64), velocity, mass| CircleState {
-        position,
-        velocity,
-        radius,
-        mass,
-        tint: [0; 3],
+    let circle = |(position, radius): (DVec2, f64), velocity, mass| {
+        CircleState::new(position, velocity, radius).with_mass(mass)
     };
     for &(k, l) in pairs.iter() {
         let (k, l) = (k as usize, l as usize);

@@ -139,6 +139,11 @@ impl Default for Effects {
 }
 
 impl Effects {
+    /// Whether any contact has friction or rolling resistance (a circle's own `Friction` aside).
+    pub fn has_friction(&self) -> bool {
+        self.friction > 0.0 || self.wall_friction > 0.0 || self.rolling_resistance > 0.0
+    }
+
     /// Whether every parameter is usable: restitutions in `[0, 1]`, friction coefficients and
     /// rolling resistance from 0 to [`MAX_FRICTION`], finite gravity, a finite non-negative
     /// drag rate.

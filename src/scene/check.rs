@@ -18,7 +18,7 @@ use crate::components::Tint;
 use crate::config::{CirclesConfig, MIN_RADIUS_FRACTION, SpawnConfig, min_radius};
 use crate::error::{FieldError, InputError};
 use crate::io::{MAX_SCENE_BYTES, read_limited};
-use crate::range::{check_mass, check_vector};
+use crate::range::{MAX_MAGNITUDE, check_magnitude, check_mass, check_vector};
 use crate::segment::{MAX_SEGMENTS, SegmentCells, Segments, check_end};
 
 impl Scene {
@@ -108,6 +108,8 @@ impl Scene {
                 radius: spec.radius,
                 mass,
                 tint: spec.color.unwrap_or(Tint::default().0),
+                angular_velocity: spec.angular_velocity,
+                rotation: 0.0,
             };
             check_circle(&circle, &arena).map_err(within)?;
             config.circles.push(circle);
@@ -190,6 +192,14 @@ pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
     }
     if c.mass != f64::INFINITY {
         check_mass("mass", c.mass)?;
+    }
+    // Its surface may turn no faster than any speed an input gives.
+    if check_magnitude("", c.angular_velocity * c.radius).is_err() {
+        let why = format!(
+            "must be finite, its surface no faster than {MAX_MAGNITUDE:e}, got {:?}",
+            c.angular_velocity
+        );
+        return Err(FieldError::new("angular_velocity", why));
     }
     if c.radius < min_radius(arena) {
         return Err(FieldError::new(

@@ -143,6 +143,8 @@ fn parse_circle(line: &str) -> Result<CircleState, String> {
         radius: x[4],
         mass: x[5],
         tint: rgb,
+        angular_velocity: 0.0,
+        rotation: 0.0,
     })
 }
 

@@ -41,6 +41,9 @@ pub struct CircleSpec {
     /// Velocity (default: at rest).
     #[serde(default)]
     pub velocity: DVec2,
+    /// Angular velocity in radians per second, counter-clockwise (default: not turning).
+    #[serde(default)]
+    pub angular_velocity: f64,
     /// Radius.
     pub radius: f64,
     /// Mass; by default from the scene's mass model.

@@ -193,6 +193,8 @@ fn drop_circles(
         radius: r,
         mass: spawn.mass.mass_of(r),
         tint: hue_to_rgb(rng.random_range(0.0..1.0)),
+        angular_velocity: 0.0,
+        rotation: 0.0,
     };
     commands.spawn(circle.bundle());
     dropped.count += 1;

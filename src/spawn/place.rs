@@ -145,6 +145,8 @@ pub fn place_circles_until(
             radius: r,
             mass: config.mass.mass_of(grown),
             tint: hue_to_rgb(rng.random_range(0.0..1.0)),
+            angular_velocity: 0.0,
+            rotation: 0.0,
         });
     }
     let mut random = placed.split_off(fixed.len());

@@ -16,6 +16,7 @@ use bevy::prelude::App;
 
 use crate::checkpoint::Checkpoint;
 use crate::circle::snapshot;
+use crate::config::Solver;
 use crate::io::{say, write_atomically};
 use crate::run::{Progress, Report, advance, default_sampling, sample_end};
 use crate::scene::particles;
@@ -52,6 +53,12 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
         }
         input => {
             let (config, source) = configure(input, &options)?;
+            if config.effects.has_friction() && !matches!(config.solver, Solver::Soft(_)) {
+                let solver = config.solver;
+                say(format_args!(
+                    "note: friction acts under `soft` only; `{solver}` treats circles as smooth"
+                ));
+            }
             let dt = config.dt;
             set_threads(options.threads);
             let Some(mut app) = start(config, &source, interrupts.stop_request())? else {
