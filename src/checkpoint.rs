@@ -237,6 +237,10 @@ impl Checkpoint {
                     "circle {i} has rotation {angle:?}, angular velocity {w:?}"
                 ));
             }
+            // A circle asleep does not turn (it would drive its neighbours like a wheel).
+            if self.sleep[i].asleep && w != 0.0 {
+                return Err(format!("circle {i} is asleep but turns at {w:?}"));
+            }
             // Every step ends with each centre inside (put back or wrapped): one outside means
             // the circle or the arena was changed. An open arena lets circles go anywhere.
             if !self.arena.is_open() && !self.arena.contains(c.position) {
@@ -249,6 +253,8 @@ impl Checkpoint {
             self.pairs.virial,
             self.walls.impulse,
             p.before.kinetic_energy,
+            p.before.rotational_energy,
+            p.before.angular_momentum,
             p.before.potential_energy,
             p.before.momentum.x,
             p.before.momentum.y,
@@ -390,6 +396,14 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("impossible radius"), "{error}");
+        // A sleeper that turns would drive its neighbours like a wheel.
+        let mut turning = good.clone();
+        turning.sleep[2].asleep = true;
+        turning.circles[2].angular_velocity = 3.0;
+        let error = Checkpoint::from_bytes(&turning.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("asleep but turns"), "{error}");
     }
 
     #[test]

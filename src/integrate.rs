@@ -51,13 +51,19 @@ fn integrate_positions(dt: Res<StepDt>, mut circles: Query<Flying>) {
 }
 
 /// Turns every circle awake by its angular velocity over `dt` (for a solver that moves the
-/// circles itself and changes no spin: `swept`, `exact`).
+/// circles itself and changes no spin: `swept`, `exact`); a circle asleep stops turning, as
+/// under the other solvers.
 pub fn turn_circles(circles: &mut SolverCircles, dt: f64) {
     for (.., sleep, (spin, rotation, _)) in circles.iter_mut() {
-        if let (Some(spin), Some(mut rotation)) = (spin, rotation)
-            && spin.0 != 0.0
-            && !sleep.asleep
-        {
+        let (Some(mut spin), Some(mut rotation)) = (spin, rotation) else {
+            continue;
+        };
+        if spin.0 == 0.0 {
+            continue;
+        }
+        if sleep.asleep {
+            spin.0 = 0.0;
+        } else {
             *rotation = rotation.turned(spin.0 * dt);
         }
     }

@@ -337,3 +337,41 @@ fn a_spinning_ball_dropped_on_the_floor_bounces_off_the_way_its_spin_throws_it()
     // Mirror images: the same speeds, opposite directions.
     assert!((vx[0] + vx[2]).abs() < 1e-9 && (w[0] + w[2]).abs() < 1e-9);
 }
+
+#[test]
+fn rolling_resistance_switched_off_leaves_no_push_behind() {
+    // A rolling disc slowed by rolling resistance, which a game then switches off: from then
+    // on it rolls at a constant speed (a warm-started torque no row takes back would drive it).
+    let (r, v0) = (0.5, 2.0);
+    let floor = Segment::new(DVec2::new(-50.0, 0.0), DVec2::new(50.0, 0.0));
+    let mut app = create_app(rough(0.5, 0.05, vec![floor]));
+    let disc = spawn_circle(&mut app, DVec2::new(-40.0, r), DVec2::new(v0, 0.0), r, 1.0);
+    app.world_mut().get_mut::<AngularVelocity>(disc).unwrap().0 = -v0 / r;
+    step(&mut app, 30);
+    assert!(
+        state(&app, disc).1.x < v0 - 0.01,
+        "rolling resistance did not slow it"
+    );
+    app.world_mut().resource_mut::<Effects>().rolling_resistance = 0.0;
+    step(&mut app, 2);
+    let v1 = state(&app, disc).1.x;
+    step(&mut app, 60);
+    assert_relative("speed once it is off", state(&app, disc).1.x, v1, 1e-9);
+}
+
+#[test]
+fn a_circle_spinning_in_place_is_not_at_rest_and_does_not_fall_asleep() {
+    // On a frictionless floor nothing slows its spin, so it never rests.
+    let mut config = rough(0.0, 0.0, Vec::new());
+    config.arena = Arena::centered(DVec2::new(16.0, 9.0));
+    config.effects.sleep = SleepConfig::default();
+    let mut app = create_app(config);
+    let top = spawn_circle(&mut app, DVec2::new(0.0, -4.0), DVec2::ZERO, 0.5, 1.0);
+    let still = spawn_circle(&mut app, DVec2::new(3.0, -4.0), DVec2::ZERO, 0.5, 1.0);
+    app.world_mut().get_mut::<AngularVelocity>(top).unwrap().0 = 5.0;
+    step(&mut app, 120);
+    let asleep = |app: &App, e: Entity| app.world().get::<Sleep>(e).unwrap().asleep;
+    assert!(asleep(&app, still), "the circle at rest did not sleep");
+    assert!(!asleep(&app, top), "the spinning circle fell asleep");
+    assert_eq!(spin(&app, top), 5.0);
+}

@@ -214,9 +214,9 @@ fn continuous_step(
         messages,
     );
     write_back(&mut state, &mut circles.p0());
+    counted.sleeping.count = write_back_sleep(&state, &mut circles.p2());
     // Smooth circles trade no spin: each turns at its own constant rate.
     turn_circles(&mut circles.p0(), dt.0);
-    counted.sleeping.count = write_back_sleep(&state, &mut circles.p2());
 }
 
 /// Writes each circle's rest back to its [`Sleep`] (in the engine's order), for the next engine

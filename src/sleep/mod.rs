@@ -168,6 +168,10 @@ fn update_sleep(
         let pushing = !movable && (velocity.0 != DVec2::ZERO || turning);
         if movable && !sleep.asleep {
             rest(&mut sleep, &config, position.0, radius.0, dt);
+            // A circle spinning in place is not at rest: its surface moves (radii per second).
+            if spin.as_ref().is_some_and(|w| w.0.abs() > config.speed) {
+                (sleep.anchor, sleep.slow_for) = (position.0, 0.0);
+            }
             ready |= sleep.slow_for >= config.time;
             stirring |= sleep.slow_for < config.time;
         }

@@ -66,7 +66,10 @@ impl Bodies {
         self.angular_velocity[i] = angular_velocity;
         self.rotation[i] = rotation;
         let r = self.radius[i];
-        self.inv_inertia[i] = 2.0 * self.inv_mass[i] / (r * r);
+        let inverse = 2.0 * self.inv_mass[i] / (r * r);
+        // A radius so small its square underflows (an arena near the least size a float
+        // holds) leaves the circle unable to turn rather than infinitely easy to.
+        self.inv_inertia[i] = if inverse.is_finite() { inverse } else { 0.0 };
     }
 
     /// Number of circles.

@@ -76,8 +76,11 @@ impl ContactCache {
             {
                 c.impulse = hit.impulse;
                 c.was_touching = hit.touching;
-                c.tangent_impulse = hit.tangent;
-                c.rolling_impulse = hit.rolling;
+                // Within what the contact allows now: friction or rolling resistance switched
+                // off (or a forged checkpoint) must not leave a push no row takes back.
+                let (most_tangent, most_rolling) = c.turning_bounds();
+                c.tangent_impulse = hit.tangent.clamp(-most_tangent, most_tangent);
+                c.rolling_impulse = hit.rolling.clamp(-most_rolling, most_rolling);
             }
         }
     }

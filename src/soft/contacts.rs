@@ -88,6 +88,15 @@ pub struct Constraint {
 }
 
 impl Constraint {
+    /// The largest tangent and rolling impulses the contact may hold now: its friction and its
+    /// rolling torque times its normal push (never negative, never NaN, so a clamp by them is
+    /// safe whatever a game wrote into `Friction`).
+    #[inline]
+    pub fn turning_bounds(&self) -> (f64, f64) {
+        let most = |k: f64| (k * self.impulse).max(0.0);
+        (most(self.friction), most(self.rolling))
+    }
+
     /// The separation along the normal for `a` at `pa` and the other side at `pb` (a wall's
     /// anchor, or `b`'s position): negative when they overlap.
     #[inline]

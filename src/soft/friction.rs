@@ -57,12 +57,16 @@ pub fn apply_turning(bodies: &mut Bodies, c: &Constraint, j: f64, k: f64) -> (f6
         let b = c.b as usize;
         if wa == 0.0 || wb == 0.0 {
             // The immovable side's surface velocity at the contact, times what it gave.
+            // The immovable side's surface velocity at the contact times what it gave, and its
+            // turning times the torque it gave.
             work = if wa == 0.0 {
-                let surface = bodies.velocity[a] + t * (bodies.angular_velocity[a] * ra);
-                (p.dot(surface), p)
+                let spin = bodies.angular_velocity[a];
+                let surface = bodies.velocity[a] + t * (spin * ra);
+                (p.dot(surface) + k * spin, p)
             } else {
-                let surface = bodies.velocity[b] - t * (bodies.angular_velocity[b] * rb);
-                (-p.dot(surface), -p)
+                let spin = bodies.angular_velocity[b];
+                let surface = bodies.velocity[b] - t * (spin * rb);
+                (-p.dot(surface) - k * spin, -p)
             };
         }
         bodies.velocity[b] += p * wb;
@@ -89,7 +93,7 @@ pub fn warm_start_turning(bodies: &mut Bodies, c: &mut Constraint) -> (f64, DVec
 #[inline]
 pub fn solve_turning(bodies: &mut Bodies, c: &mut Constraint) -> (f64, DVec2) {
     let (vt, ..) = sliding(bodies, c);
-    let most = c.friction * c.impulse;
+    let (most, most_rolling) = c.turning_bounds();
     let total = (c.tangent_impulse - c.tangent_mass * vt).clamp(-most, most);
     let j = total - c.tangent_impulse;
     c.tangent_impulse = total;
@@ -100,7 +104,7 @@ pub fn solve_turning(bodies: &mut Bodies, c: &mut Constraint) -> (f64, DVec2) {
         let (ia, ib) = c.inv_inertia;
         let (ra, rb) = c.lever;
         let turning = (wb - ib * rb * j) - (wa - ia * ra * j);
-        let most = c.rolling * c.impulse;
+        let most = most_rolling;
         let total = (c.rolling_impulse - c.rolling_mass * turning).clamp(-most, most);
         k = total - c.rolling_impulse;
         c.rolling_impulse = total;
