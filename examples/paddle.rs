@@ -67,12 +67,15 @@ fn main() -> AppExit {
     }
 }
 
+/// The paddle, and not the ball.
+type PaddleOnly = (With<Paddle>, Without<Ball>);
+
 /// Before each step: the paddle heads for where the ball will come down to its height (a
 /// little to the outside of it, so the ball bounces back towards the middle), no faster than
 /// its speed, and stays at its height.
 fn steer(
     ball: Single<(&Position, &Velocity), With<Ball>>,
-    mut paddle: Single<(&Position, &mut Velocity), (With<Paddle>, Without<Ball>)>,
+    mut paddle: Single<(&Position, &mut Velocity), PaddleOnly>,
 ) {
     let ((p, v), (at, velocity)) = (*ball, &mut *paddle);
     // y(t) = p.y + v.y t − g t² / 2 reaches the top of the paddle at the later root.

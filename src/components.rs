@@ -175,17 +175,24 @@ pub type SolverCircles<'w, 's> = Query<
         &'static Mass,
         Option<&'static Restitution>,
         &'static Sleep,
-        Spin,
     ),
 >;
 
-/// How a circle turns, as the solvers read and write it: its angular velocity and rotation
-/// (either may be absent: the circle then does not turn) and its own friction.
-pub type Spin = (
-    Option<&'static mut AngularVelocity>,
-    Option<&'static mut Rotation>,
-    Option<&'static Friction>,
-);
+/// How circles turn, as the solvers read and write it, in a query of its own so that a step
+/// in which nothing turns pays nothing for it: each circle's angular velocity and rotation
+/// (either may be absent: the circle then does not turn), its own friction, and whether it
+/// sleeps.
+pub type SpinCircles<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Option<&'static mut AngularVelocity>,
+        Option<&'static mut Rotation>,
+        Option<&'static Friction>,
+        &'static Sleep,
+    ),
+    With<Radius>,
+>;
 
 impl From<DVec2> for Position {
     fn from(v: DVec2) -> Self {

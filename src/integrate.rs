@@ -3,7 +3,7 @@
 
 use bevy::prelude::*;
 
-use crate::components::{AngularVelocity, Position, Rotation, Sleep, SolverCircles, Velocity};
+use crate::components::{AngularVelocity, Position, Rotation, Sleep, SpinCircles, Velocity};
 use crate::schedule::{CircleStep, CircleSystems, StepDt};
 
 /// Moves every circle along its velocity for one (sub)step.
@@ -53,8 +53,8 @@ fn integrate_positions(dt: Res<StepDt>, mut circles: Query<Flying>) {
 /// Turns every circle awake by its angular velocity over `dt` (for a solver that moves the
 /// circles itself and changes no spin: `swept`, `exact`); a circle asleep stops turning, as
 /// under the other solvers.
-pub fn turn_circles(circles: &mut SolverCircles, dt: f64) {
-    for (.., sleep, (spin, rotation, _)) in circles.iter_mut() {
+pub fn turn_circles(circles: &mut SpinCircles, dt: f64) {
+    for (spin, rotation, _, sleep) in circles.iter_mut() {
         let (Some(mut spin), Some(mut rotation)) = (spin, rotation) else {
             continue;
         };

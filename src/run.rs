@@ -297,10 +297,13 @@ impl Report {
             self.momentum_initial[1],
             self.momentum_final[0],
             self.momentum_final[1],
+            self.angular_momentum_initial,
+            self.angular_momentum_final,
             self.max_penetration,
             self.mean_penetration,
             self.final_penetration,
             self.kinetic_final,
+            self.rotational_final,
             self.z.unwrap_or(0.0),
             self.z_wall.unwrap_or(0.0),
         ];

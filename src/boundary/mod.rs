@@ -189,7 +189,7 @@ fn bounce_off_walls(
     let (log, entities) = &mut *log;
     let mut hits = 0u64;
     let mut impulse = 0.0f64;
-    for (entity, mut position, mut velocity, radius, mass, own, sleep, _) in &mut circles {
+    for (entity, mut position, mut velocity, radius, mass, own, sleep) in &mut circles {
         if sleep.asleep {
             continue;
         }

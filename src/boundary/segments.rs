@@ -135,7 +135,7 @@ fn bounce_off_segments(
     let Some(cells) = cells.as_ref() else { return };
     let (log, entities, near) = &mut *scratch;
     let (mut hits, mut impulse) = (0u64, 0.0f64);
-    for (entity, mut position, mut velocity, radius, mass, own, sleep, _) in &mut circles {
+    for (entity, mut position, mut velocity, radius, mass, own, sleep) in &mut circles {
         if sleep.asleep {
             continue;
         }

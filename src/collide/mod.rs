@@ -89,7 +89,7 @@ fn collide_circles(
     let (log, entities) = &mut *log;
     entities.clear();
     let per_circle = !own_restitution.is_empty();
-    for (e, p, v, r, m, own, sleep, _) in &circles {
+    for (e, p, v, r, m, own, sleep) in &circles {
         // A sleeping circle is an immovable circle at rest until it is woken.
         let mass = if sleep.asleep { f64::INFINITY } else { m.0 };
         scratch.push(p.0, v.0, r.0, mass);

@@ -29,7 +29,9 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::circle::CircleState;
 use crate::collide::PairCollisions;
-use crate::components::{Mass, Position, Radius, Restitution, Sleep, SolverCircles, Velocity};
+use crate::components::{
+    Mass, Position, Radius, Restitution, Sleep, SolverCircles, SpinCircles, Velocity,
+};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
 use crate::integrate::turn_circles;
@@ -160,6 +162,14 @@ type ChangedCircles<'w, 's> = Query<
     ),
 >;
 
+/// The circles as the step sees them, one view at a time: all, changed, sleep, spin.
+type EngineViews = (
+    SolverCircles<'static, 'static>,
+    ChangedCircles<'static, 'static>,
+    Query<'static, 'static, &'static mut Sleep>,
+    SpinCircles<'static, 'static>,
+);
+
 /// What the continuous step counts: hits of each kind, and the circles asleep.
 #[derive(SystemParam)]
 struct Counted<'w> {
@@ -186,7 +196,7 @@ fn continuous_step(
     mut state: ResMut<EngineState>,
     own_restitution: Query<(), With<Restitution>>,
     mut lost_restitution: RemovedComponents<Restitution>,
-    mut circles: ParamSet<(SolverCircles, ChangedCircles, Query<&mut Sleep>)>,
+    mut circles: ParamSet<EngineViews>,
     mut counted: Counted,
     messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
 ) {
@@ -215,8 +225,7 @@ fn continuous_step(
     );
     write_back(&mut state, &mut circles.p0());
     counted.sleeping.count = write_back_sleep(&state, &mut circles.p2());
-    // Smooth circles trade no spin: each turns at its own constant rate.
-    turn_circles(&mut circles.p0(), dt.0);
+    turn_circles(&mut circles.p3(), dt.0); // smooth circles trade no spin
 }
 
 /// Writes each circle's rest back to its [`Sleep`] (in the engine's order), for the next engine
@@ -258,7 +267,7 @@ fn gather_into_engine(
     (setup, stop): ((Solver, Arena, Effects, &Segments), Option<&StopRequest>),
     state: &mut EngineState,
     restitution: (bool, bool),
-    circles: &mut ParamSet<(SolverCircles, ChangedCircles, Query<&mut Sleep>)>,
+    circles: &mut ParamSet<EngineViews>,
 ) {
     let (solver, arena, effects, segments) = setup;
     let (restitution_lost, with_own_restitution) = restitution;

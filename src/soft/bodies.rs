@@ -16,7 +16,8 @@ pub struct Bodies {
     pub radius: Vec<f64>,
     /// Inverse masses: 0 for an immovable (static or kinematic) circle.
     pub inv_mass: Vec<f64>,
-    /// Angular velocities (counter-clockwise, radians per second).
+    /// Angular velocities (counter-clockwise, radians per second); these three are empty in a
+    /// step in which nothing turns ([`Bodies::start_turning`]).
     pub angular_velocity: Vec<f64>,
     /// Rotations (radians, in `[-π, π]`).
     pub rotation: Vec<f64>,
@@ -54,15 +55,23 @@ impl Bodies {
         self.velocity.push(velocity);
         self.radius.push(radius);
         self.inv_mass.push(inv_mass);
-        self.angular_velocity.push(0.0);
-        self.rotation.push(0.0);
-        self.inv_inertia.push(0.0);
     }
 
-    /// Lets the circle added last turn: at `angular_velocity`, from `rotation`, as a uniform
-    /// disc (moment of inertia `m r² / 2`) if it is movable.
-    pub fn turning(&mut self, angular_velocity: f64, rotation: f64) {
-        let i = self.len() - 1;
+    /// Makes room for every circle to turn (none turning yet): the step may turn circles.
+    pub fn start_turning(&mut self) {
+        let n = self.len();
+        for spin in [
+            &mut self.angular_velocity,
+            &mut self.rotation,
+            &mut self.inv_inertia,
+        ] {
+            spin.resize(n, 0.0);
+        }
+    }
+
+    /// Lets circle `i` turn: at `angular_velocity`, from `rotation`, as a uniform disc (moment
+    /// of inertia `m r² / 2`) if it is movable. Call [`Bodies::start_turning`] first.
+    pub fn turning(&mut self, i: usize, angular_velocity: f64, rotation: f64) {
         self.angular_velocity[i] = angular_velocity;
         self.rotation[i] = rotation;
         let r = self.radius[i];

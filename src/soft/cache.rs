@@ -7,8 +7,9 @@
 use bevy::platform::collections::HashMap;
 use serde::{Deserialize, Serialize};
 
-use super::contacts::{Constraint, Partner};
+use super::contacts::{Constraint, Partner, TurningRow};
 use crate::circle::CircleState;
+use crate::grid::NONE;
 use crate::hits::Wall;
 use crate::range::MAX_MAGNITUDE;
 
@@ -47,8 +48,14 @@ impl ContactCache {
     }
 
     /// Gives every contact in `constraints` the impulse it ended last step with, and whether
-    /// it pushed then. `ids` are the circles' identities now.
-    pub fn warm_start(&mut self, ids: &[u64], constraints: &mut [Constraint]) {
+    /// it pushed then (and its row in `rows`, if it has friction, the friction and rolling
+    /// impulses it ended with). `ids` are the circles' identities now.
+    pub fn warm_start(
+        &mut self,
+        ids: &[u64],
+        constraints: &mut [Constraint],
+        rows: &mut [TurningRow],
+    ) {
         if self.entries.is_empty() {
             return;
         }
@@ -76,11 +83,15 @@ impl ContactCache {
             {
                 c.impulse = hit.impulse;
                 c.was_touching = hit.touching;
-                // Within what the contact allows now: friction or rolling resistance switched
-                // off (or a forged checkpoint) must not leave a push no row takes back.
-                let (most_tangent, most_rolling) = c.turning_bounds();
-                c.tangent_impulse = hit.tangent.clamp(-most_tangent, most_tangent);
-                c.rolling_impulse = hit.rolling.clamp(-most_rolling, most_rolling);
+                if c.turn != NONE {
+                    // Within what the contact allows now: friction or rolling resistance
+                    // switched off (or a forged checkpoint) must not leave a push no row takes
+                    // back.
+                    let row = &mut rows[c.turn as usize];
+                    let (most_tangent, most_rolling) = row.bounds(c.impulse);
+                    row.tangent_impulse = hit.tangent.clamp(-most_tangent, most_tangent);
+                    row.rolling_impulse = hit.rolling.clamp(-most_rolling, most_rolling);
+                }
             }
         }
     }
@@ -160,12 +171,13 @@ impl ContactCache {
         })
     }
 
-    /// Keeps the impulses `constraints` ended the step with, for the next step's
-    /// [`ContactCache::warm_start`].
+    /// Keeps the impulses `constraints` (and their `rows`) ended the step with, for the next
+    /// step's [`ContactCache::warm_start`].
     pub fn store<'a>(
         &mut self,
         ids: &[u64],
         constraints: impl Iterator<Item = &'a Constraint> + Clone,
+        rows: &[TurningRow],
     ) {
         self.ids.clear();
         self.ids.extend_from_slice(ids);
@@ -190,13 +202,17 @@ impl ContactCache {
         self.entries.clear();
         self.entries.resize(self.start[ids.len()] as usize, empty);
         for c in constraints {
+            let (tangent, rolling) = match rows.get(c.turn as usize) {
+                Some(row) => (row.tangent_impulse, row.rolling_impulse),
+                None => (0.0, 0.0),
+            };
             let slot = &mut next[c.a as usize];
             self.entries[*slot as usize] = Cached {
                 partner: c.partner,
                 impulse: c.impulse,
                 touching: c.total_impulse > 0.0,
-                tangent: c.tangent_impulse,
-                rolling: c.rolling_impulse,
+                tangent,
+                rolling,
             };
             *slot += 1;
         }

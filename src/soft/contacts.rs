@@ -69,34 +69,11 @@ pub struct Constraint {
     pub approach: f64,
     /// Whether the contact pushed in the last step (a new push is a collision to count).
     pub was_touching: bool,
-    /// Coefficient of friction of the pair (0: smooth, no tangent row).
-    pub friction: f64,
-    /// Rolling resistance times the lever it acts on: the most torque per unit of normal push.
-    pub rolling: f64,
-    /// Distances from `a`'s and `b`'s centres to the contact point (`b`'s 0 for a wall).
-    pub lever: (f64, f64),
-    /// Inverse moments of inertia of the two sides (0 for a side that cannot turn).
-    pub inv_inertia: (f64, f64),
-    /// `1 / (w_a + w_b + i_a r_a² + i_b r_b²)`: the mass the tangent row moves.
-    pub tangent_mass: f64,
-    /// `1 / (i_a + i_b)`, or 0 if neither side turns: the inertia the rolling row turns.
-    pub rolling_mass: f64,
-    /// Tangent impulse accumulated in the current substep (warm started like `impulse`).
-    pub tangent_impulse: f64,
-    /// Rolling (torque) impulse accumulated in the current substep.
-    pub rolling_impulse: f64,
+    /// Its [`TurningRow`]'s index in the step's rows, or `NONE` (`u32::MAX`) without friction.
+    pub turn: u32,
 }
 
 impl Constraint {
-    /// The largest tangent and rolling impulses the contact may hold now: its friction and its
-    /// rolling torque times its normal push (never negative, never NaN, so a clamp by them is
-    /// safe whatever a game wrote into `Friction`).
-    #[inline]
-    pub fn turning_bounds(&self) -> (f64, f64) {
-        let most = |k: f64| (k * self.impulse).max(0.0);
-        (most(self.friction), most(self.rolling))
-    }
-
     /// The separation along the normal for `a` at `pa` and the other side at `pb` (a wall's
     /// anchor, or `b`'s position): negative when they overlap.
     #[inline]
@@ -130,29 +107,100 @@ pub struct ContactRules {
     pub rolling_resistance: f64,
 }
 
-/// The tangent and rolling rows of a contact between sides of inverse masses `w`, inverse
-/// inertias `i`, at distances `lever` from the contact point, with friction `friction` and a
-/// rolling torque per unit of push of `rolling`: the fields a [`Constraint`] ends with, none
-/// turning when there is no friction.
-fn turning_rows(
-    w: (f64, f64),
-    i: (f64, f64),
-    lever: (f64, f64),
-    friction: f64,
-    rolling: f64,
-) -> (f64, f64, f64, f64) {
-    if friction == 0.0 {
-        return (0.0, 0.0, 0.0, 0.0);
+/// The friction and rolling rows of a contact: what it needs besides its normal push to stop
+/// sliding and turning ([`super::friction`]). Only contacts with friction have one, so a
+/// frictionless step carries none.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TurningRow {
+    /// Coefficient of friction of the pair.
+    pub friction: f64,
+    /// Rolling resistance times the lever it acts on: the most torque per unit of normal push
+    /// (0 when neither side turns).
+    pub rolling: f64,
+    /// Distances from `a`'s and `b`'s centres to the contact point (`b`'s 0 for a wall).
+    pub lever: (f64, f64),
+    /// Inverse moments of inertia of the two sides (0 for a side that cannot turn).
+    pub inv_inertia: (f64, f64),
+    /// `1 / (w_a + w_b + i_a r_a² + i_b r_b²)`: the mass the tangent row moves.
+    pub tangent_mass: f64,
+    /// `1 / (i_a + i_b)`, or 0 if neither side turns: the inertia the rolling row turns.
+    pub rolling_mass: f64,
+    /// Tangent impulse accumulated in the current substep (warm started like the normal one).
+    pub tangent_impulse: f64,
+    /// Rolling (torque) impulse accumulated in the current substep.
+    pub rolling_impulse: f64,
+}
+
+impl TurningRow {
+    /// The largest tangent and rolling impulses the row may hold while its contact pushes
+    /// with `impulse`: its friction and its rolling torque times it (never negative, never
+    /// NaN, so a clamp by them is safe whatever a game wrote into `Friction`).
+    #[inline]
+    pub fn bounds(&self, impulse: f64) -> (f64, f64) {
+        let most = |k: f64| (k * impulse).max(0.0);
+        (most(self.friction), most(self.rolling))
     }
-    let k = w.0 + w.1 + i.0 * lever.0 * lever.0 + i.1 * lever.1 * lever.1;
-    let spin = i.0 + i.1;
-    let rolling_mass = if spin > 0.0 && rolling > 0.0 {
-        1.0 / spin
-    } else {
-        0.0
-    };
-    let rolling = if rolling_mass > 0.0 { rolling } else { 0.0 };
-    (friction, rolling, 1.0 / k, rolling_mass)
+}
+
+/// Whether a step under `rules` with `bodies` may have friction anywhere.
+pub fn may_turn(bodies: &Bodies, rules: &ContactRules) -> bool {
+    rules.friction.0 > 0.0 || rules.friction.1 > 0.0 || !bodies.friction.is_empty()
+}
+
+/// Gives every contact in `contacts` that has friction a [`TurningRow`] in `rows` (its `turn`
+/// the row's index); the others keep `NONE`.
+pub fn turning_rows<'a>(
+    bodies: &Bodies,
+    rules: &ContactRules,
+    contacts: impl Iterator<Item = &'a mut Constraint>,
+    rows: &mut Vec<TurningRow>,
+) {
+    rows.clear();
+    for c in contacts {
+        let i = c.a as usize;
+        let own = |k: usize| bodies.own_friction(k);
+        let (friction, other) = if c.b == NONE {
+            // The walls' coefficient is that of a circle against them; a circle's own meets it.
+            let walls = rules.friction.1;
+            let friction = own(i).map_or(walls, |own| rules.combine.apply(own, walls));
+            (friction, None)
+        } else {
+            let j = c.b as usize;
+            let scene = rules.friction.0;
+            let friction = rules
+                .combine
+                .apply(own(i).unwrap_or(scene), own(j).unwrap_or(scene));
+            (friction, Some(j))
+        };
+        if friction <= 0.0 || friction.is_nan() {
+            continue;
+        }
+        let (wa, wb) = c.inv_mass;
+        let ia = bodies.inv_inertia[i];
+        let (ib, lever) = match other {
+            Some(j) => (bodies.inv_inertia[j], (bodies.radius[i], bodies.radius[j])),
+            None => (0.0, (bodies.radius[i], 0.0)),
+        };
+        let smaller = lever.0.min(if other.is_some() { lever.1 } else { lever.0 });
+        let spin = ia + ib;
+        let rolling = rules.rolling_resistance * smaller;
+        let rolling_mass = if spin > 0.0 && rolling > 0.0 {
+            1.0 / spin
+        } else {
+            0.0
+        };
+        c.turn = rows.len() as u32;
+        rows.push(TurningRow {
+            friction,
+            rolling: if rolling_mass > 0.0 { rolling } else { 0.0 },
+            lever,
+            inv_inertia: (ia, ib),
+            tangent_mass: 1.0 / (wa + wb + ia * lever.0 * lever.0 + ib * lever.1 * lever.1),
+            rolling_mass,
+            tangent_impulse: 0.0,
+            rolling_impulse: 0.0,
+        });
+    }
 }
 
 /// Reusable buffers of contact finding.
@@ -298,17 +346,6 @@ fn pair_contact(
         bodies.restitution_of(i, rules.restitution.0),
         bodies.restitution_of(j, rules.restitution.0),
     );
-    let lever = (bodies.radius[i], bodies.radius[j]);
-    let (friction, rolling, tangent_mass, rolling_mass) = turning_rows(
-        (wa, wb),
-        (bodies.inv_inertia[i], bodies.inv_inertia[j]),
-        lever,
-        rules.combine.apply(
-            bodies.own_friction(i).unwrap_or(rules.friction.0),
-            bodies.own_friction(j).unwrap_or(rules.friction.0),
-        ),
-        rules.rolling_resistance * smaller,
-    );
     Some(Constraint {
         a: i as u32,
         b: j as u32,
@@ -331,14 +368,7 @@ fn pair_contact(
         total_impulse: 0.0,
         approach: 0.0,
         was_touching: false,
-        friction,
-        rolling,
-        lever,
-        inv_inertia: (bodies.inv_inertia[i], bodies.inv_inertia[j]),
-        tangent_mass,
-        rolling_mass,
-        tangent_impulse: 0.0,
-        rolling_impulse: 0.0,
+        turn: NONE,
     })
 }
 
@@ -354,19 +384,6 @@ fn wall_contact(
 ) -> Constraint {
     let (r, w) = (bodies.radius[i], bodies.inv_mass[i]);
     let own = bodies.restitution_of(i, rules.restitution.1);
-    // The walls' coefficient is that of a circle against them; a circle's own meets it.
-    let walls = rules.friction.1;
-    let friction = bodies
-        .own_friction(i)
-        .map_or(walls, |own| rules.combine.apply(own, walls));
-    let inertia = bodies.inv_inertia[i];
-    let (friction, rolling, tangent_mass, rolling_mass) = turning_rows(
-        (w, 0.0),
-        (inertia, 0.0),
-        (r, 0.0),
-        friction,
-        rules.rolling_resistance * r,
-    );
     Constraint {
         a: i as u32,
         b: NONE,
@@ -385,13 +402,6 @@ fn wall_contact(
         total_impulse: 0.0,
         approach: 0.0,
         was_touching: false,
-        friction,
-        rolling,
-        lever: (r, 0.0),
-        inv_inertia: (inertia, 0.0),
-        tangent_mass,
-        rolling_mass,
-        tangent_impulse: 0.0,
-        rolling_impulse: 0.0,
+        turn: NONE,
     }
 }

@@ -13,7 +13,7 @@
 use bevy::math::DVec2;
 
 use super::bodies::Bodies;
-use super::contacts::Constraint;
+use super::contacts::{Constraint, TurningRow};
 use crate::grid::NONE;
 
 /// The tangent of normal `n`: `n` turned a quarter turn counter-clockwise.
@@ -22,12 +22,12 @@ pub fn tangent(n: DVec2) -> DVec2 {
     DVec2::new(-n.y, n.x)
 }
 
-/// How fast the other side of contact `c` slides past `a` along the tangent, and the two
-/// sides' angular velocities.
+/// How fast the other side of contact `c` (with row `row`) slides past `a` along the tangent,
+/// and the two sides' angular velocities.
 #[inline]
-fn sliding(bodies: &Bodies, c: &Constraint) -> (f64, f64, f64) {
+fn sliding(bodies: &Bodies, c: &Constraint, row: &TurningRow) -> (f64, f64, f64) {
     let a = c.a as usize;
-    let (ra, rb) = c.lever;
+    let (ra, rb) = row.lever;
     let t = tangent(c.normal);
     let wa = bodies.angular_velocity[a];
     let (vb, wb) = if c.b == NONE {
@@ -45,10 +45,15 @@ fn sliding(bodies: &Bodies, c: &Constraint) -> (f64, f64, f64) {
 /// Returns the work an immovable side did on the other through the tangent impulse, and the
 /// momentum it gave.
 #[inline]
-pub fn apply_turning(bodies: &mut Bodies, c: &Constraint, j: f64, k: f64) -> (f64, DVec2) {
+pub fn apply_turning(
+    bodies: &mut Bodies,
+    (c, row): (&Constraint, &TurningRow),
+    j: f64,
+    k: f64,
+) -> (f64, DVec2) {
     let (wa, wb) = c.inv_mass;
-    let (ia, ib) = c.inv_inertia;
-    let (ra, rb) = c.lever;
+    let (ia, ib) = row.inv_inertia;
+    let (ra, rb) = row.lever;
     let t = tangent(c.normal);
     let p = t * j;
     let a = c.a as usize;
@@ -77,13 +82,14 @@ pub fn apply_turning(bodies: &mut Bodies, c: &Constraint, j: f64, k: f64) -> (f6
     work
 }
 
-/// Applies contact `c`'s tangent and rolling impulses from the last substep (or step) again.
+/// Applies the tangent and rolling impulses of contact `c`'s row from the last substep (or
+/// step) again.
 #[inline]
-pub fn warm_start_turning(bodies: &mut Bodies, c: &mut Constraint) -> (f64, DVec2) {
-    if c.tangent_impulse == 0.0 && c.rolling_impulse == 0.0 {
+pub fn warm_start_turning(bodies: &mut Bodies, c: &Constraint, row: &TurningRow) -> (f64, DVec2) {
+    if row.tangent_impulse == 0.0 && row.rolling_impulse == 0.0 {
         return (0.0, DVec2::ZERO);
     }
-    apply_turning(bodies, c, c.tangent_impulse, c.rolling_impulse)
+    apply_turning(bodies, (c, row), row.tangent_impulse, row.rolling_impulse)
 }
 
 /// Solves contact `c`'s tangent row (stop the sliding, within μ times the normal push the
@@ -91,25 +97,24 @@ pub fn warm_start_turning(bodies: &mut Bodies, c: &mut Constraint) -> (f64, DVec
 /// resistance's torque). Returns the work an immovable side did through them, and the
 /// momentum it gave.
 #[inline]
-pub fn solve_turning(bodies: &mut Bodies, c: &mut Constraint) -> (f64, DVec2) {
-    let (vt, ..) = sliding(bodies, c);
-    let (most, most_rolling) = c.turning_bounds();
-    let total = (c.tangent_impulse - c.tangent_mass * vt).clamp(-most, most);
-    let j = total - c.tangent_impulse;
-    c.tangent_impulse = total;
+pub fn solve_turning(bodies: &mut Bodies, c: &Constraint, row: &mut TurningRow) -> (f64, DVec2) {
+    let (vt, wa, wb) = sliding(bodies, c, row);
+    let (most, most_rolling) = row.bounds(c.impulse);
+    let total = (row.tangent_impulse - row.tangent_mass * vt).clamp(-most, most);
+    let j = total - row.tangent_impulse;
+    row.tangent_impulse = total;
     let mut k = 0.0;
-    if c.rolling > 0.0 {
-        let (_, wa, wb) = sliding(bodies, c);
+    if row.rolling > 0.0 {
         // The tangent impulse just found turns both sides: roll against what it leaves.
-        let (ia, ib) = c.inv_inertia;
-        let (ra, rb) = c.lever;
+        let (ia, ib) = row.inv_inertia;
+        let (ra, rb) = row.lever;
         let turning = (wb - ib * rb * j) - (wa - ia * ra * j);
-        let most = most_rolling;
-        let total = (c.rolling_impulse - c.rolling_mass * turning).clamp(-most, most);
-        k = total - c.rolling_impulse;
-        c.rolling_impulse = total;
+        let total =
+            (row.rolling_impulse - row.rolling_mass * turning).clamp(-most_rolling, most_rolling);
+        k = total - row.rolling_impulse;
+        row.rolling_impulse = total;
     }
-    apply_turning(bodies, c, j, k)
+    apply_turning(bodies, (c, row), j, k)
 }
 
 /// Every circle turned by its angular velocity over `h` seconds, its rotation kept in `[-π, π]`.
@@ -130,10 +135,11 @@ mod tests {
 
     /// A disc of unit mass and radius resting on a floor below it, moving at `v` and turning
     /// at `w`, with friction `mu` and a normal push of 1 held.
-    fn on_floor(v: f64, w: f64, mu: f64) -> (Bodies, Constraint) {
+    fn on_floor(v: f64, w: f64, mu: f64) -> (Bodies, Constraint, TurningRow) {
         let mut bodies = Bodies::default();
         bodies.push(1, DVec2::ZERO, DVec2::new(v, 0.0), 1.0, 1.0);
-        bodies.turning(w, 0.0);
+        bodies.start_turning();
+        bodies.turning(0, w, 0.0);
         let c = Constraint {
             a: 0,
             b: NONE,
@@ -152,6 +158,9 @@ mod tests {
             total_impulse: 1.0,
             approach: 0.0,
             was_touching: true,
+            turn: 0,
+        };
+        let row = TurningRow {
             friction: mu,
             rolling: 0.0,
             lever: (1.0, 0.0),
@@ -161,44 +170,44 @@ mod tests {
             tangent_impulse: 0.0,
             rolling_impulse: 0.0,
         };
-        (bodies, c)
+        (bodies, c, row)
     }
 
     #[test]
     fn enough_friction_makes_a_sliding_disc_roll_and_keeps_two_thirds_of_its_speed() {
         // A uniform disc sliding at 3 with no spin rolls, after the friction's one impulse,
         // at 2 (momentum about the contact point is kept: m v r = (m + I / r²) v').
-        let (mut bodies, mut c) = on_floor(3.0, 0.0, 10.0);
-        solve_turning(&mut bodies, &mut c);
+        let (mut bodies, c, mut row) = on_floor(3.0, 0.0, 10.0);
+        solve_turning(&mut bodies, &c, &mut row);
         let (v, w) = (bodies.velocity[0].x, bodies.angular_velocity[0]);
         assert!((v - 2.0).abs() < 1e-12, "{v}");
         // Rolling to the right on a floor below turns clockwise: v = −ω r.
         assert!((w + 2.0).abs() < 1e-12, "{w}");
-        assert!(sliding(&bodies, &c).0.abs() < 1e-12);
+        assert!(sliding(&bodies, &c, &row).0.abs() < 1e-12);
     }
 
     #[test]
     fn too_little_friction_only_slows_the_slide_by_mu_times_the_push() {
-        let (mut bodies, mut c) = on_floor(3.0, 0.0, 0.25);
-        solve_turning(&mut bodies, &mut c);
+        let (mut bodies, c, mut row) = on_floor(3.0, 0.0, 0.25);
+        solve_turning(&mut bodies, &c, &mut row);
         assert!((bodies.velocity[0].x - 2.75).abs() < 1e-12);
-        assert!((c.tangent_impulse.abs() - 0.25).abs() < 1e-12);
+        assert!((row.tangent_impulse.abs() - 0.25).abs() < 1e-12);
         // And a rolling disc needs no friction at all.
-        let (mut bodies, mut c) = on_floor(3.0, -3.0, 0.25);
-        solve_turning(&mut bodies, &mut c);
-        assert_eq!((bodies.velocity[0].x, c.tangent_impulse), (3.0, 0.0));
+        let (mut bodies, c, mut row) = on_floor(3.0, -3.0, 0.25);
+        solve_turning(&mut bodies, &c, &mut row);
+        assert_eq!((bodies.velocity[0].x, row.tangent_impulse), (3.0, 0.0));
     }
 
     #[test]
     fn rolling_resistance_slows_the_turning_within_its_torque() {
-        let (mut bodies, mut c) = on_floor(3.0, -3.0, 10.0);
-        c.rolling = 0.01;
-        solve_turning(&mut bodies, &mut c);
+        let (mut bodies, c, mut row) = on_floor(3.0, -3.0, 10.0);
+        row.rolling = 0.01;
+        solve_turning(&mut bodies, &c, &mut row);
         // At most 0.01 of torque impulse: the spin slows by 0.02 (inverse inertia 2).
-        assert!((c.rolling_impulse.abs() - 0.01).abs() < 1e-12);
+        assert!((row.rolling_impulse.abs() - 0.01).abs() < 1e-12);
         assert!((bodies.angular_velocity[0] + 2.98).abs() < 1e-12);
         // The next pass: friction makes the disc roll again, so its speed drops too.
-        solve_turning(&mut bodies, &mut c);
+        solve_turning(&mut bodies, &c, &mut row);
         let (v, w) = (bodies.velocity[0].x, bodies.angular_velocity[0]);
         assert!(v < 3.0 && (v + w).abs() < 1e-12, "{v} {w}");
     }

@@ -16,6 +16,7 @@ pub mod cache;
 pub mod contacts;
 pub mod friction;
 pub mod solve;
+pub mod stats;
 
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
@@ -24,14 +25,15 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
-use crate::components::{Friction, Restitution, SolverCircles};
+use crate::components::{Friction, Restitution, Sleep, SolverCircles, SpinCircles};
 use crate::config::{Effects, SoftConfig, Solver};
 use crate::hits::{CircleHit, HitLog, WallHit};
 use crate::schedule::{CircleSystems, SoftStep, StepDt};
 use crate::segment::{SegmentCells, Segments};
 pub use bodies::{Bodies, Softness};
 pub use cache::{CacheSnapshot, ContactCache};
-pub use solve::{SoftParams, SoftScratch, SoftStats, soft_step};
+pub use solve::{SoftParams, SoftScratch, soft_step};
+pub use stats::SoftStats;
 
 /// Adds the `soft` step to [`SoftStep`].
 #[derive(Clone, Copy, Debug, Default)]
@@ -117,7 +119,7 @@ fn step_soft(
     own: (Query<(), With<Restitution>>, Query<(), With<Friction>>),
     counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
-    mut circles: SolverCircles,
+    (mut circles, mut spins): (SolverCircles, SpinCircles),
 ) {
     let SoftSetup {
         solver,
@@ -139,29 +141,30 @@ fn step_soft(
     let per_circle = (!own.0.is_empty(), !own.1.is_empty());
     bodies.clear();
     entities.clear();
-    for (entity, p, v, r, m, restitution, sleep, (spin, rotation, friction)) in &circles {
+    for (entity, p, v, r, m, restitution, sleep) in &circles {
         // A sleeping circle is an immovable circle at rest until it is woken.
         let inverse = if sleep.asleep { 0.0 } else { m.inverse() };
         bodies.push(entity.to_bits(), p.0, v.0, r.0, inverse);
-        if let (Some(spin), Some(rotation)) = (spin, rotation) {
-            bodies.turning(spin.0, rotation.0);
-        }
         if per_circle.0 {
             let scene = effects.restitution;
             bodies
                 .restitution
                 .push(restitution.map_or(scene, |own| own.0));
         }
-        if per_circle.1 {
-            bodies.friction.push(friction.map_or(f64::NAN, |own| own.0));
-        }
         entities.push(entity);
+    }
+    // Spin only where something may turn: friction, or a circle turning already.
+    let spinning = effects.has_friction()
+        || per_circle.1
+        || spins.iter().any(|(w, ..)| w.is_some_and(|w| w.0 != 0.0));
+    if spinning {
+        gather_spin(bodies, entities, &spins, per_circle.1);
     }
     // Everything asleep or static: nothing can move this step.
     let moving = |i: usize| {
         bodies.inv_mass[i] > 0.0
             || bodies.velocity[i] != DVec2::ZERO
-            || bodies.angular_velocity[i] != 0.0
+            || bodies.angular_velocity.get(i).is_some_and(|&w| w != 0.0)
     };
     if !(0..bodies.len()).any(moving) {
         *last = SoftStats::default();
@@ -202,7 +205,7 @@ fn step_soft(
         log.send_circle_hits(|i| entities[i as usize], 0.0, &mut messages.0);
         log.send_wall_hits(|i| entities[i as usize], 0.0, &mut messages.1);
     }
-    for (i, (_, mut p, mut v, .., (spin, rotation, _))) in circles.iter_mut().enumerate() {
+    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
         let (position, velocity) = (bodies.position[i], bodies.velocity[i]);
         if p.0 != position {
             p.0 = position;
@@ -210,14 +213,45 @@ fn step_soft(
         if v.0 != velocity {
             v.0 = velocity;
         }
-        if let (Some(mut spin), Some(mut rotation)) = (spin, rotation) {
-            let (w, angle) = (bodies.angular_velocity[i], bodies.rotation[i]);
-            if spin.0 != w {
-                spin.0 = w;
-            }
-            if rotation.0 != angle {
-                rotation.0 = angle;
-            }
+    }
+    if !bodies.angular_velocity.is_empty() {
+        write_back_spin(bodies, entities, &mut spins);
+    }
+}
+
+/// What a circle the spin query does not see has: it does not turn.
+const SLEEP: Sleep = Sleep {
+    anchor: DVec2::ZERO,
+    slow_for: 0.0,
+    asleep: false,
+};
+
+/// Each circle's spin (and own friction, when `own_friction`) into `bodies`, by entity.
+fn gather_spin(bodies: &mut Bodies, entities: &[Entity], spins: &SpinCircles, own_friction: bool) {
+    bodies.start_turning();
+    for (i, &entity) in entities.iter().enumerate() {
+        let (spin, rotation, friction, _) = spins.get(entity).unwrap_or((None, None, None, &SLEEP));
+        if let (Some(spin), Some(rotation)) = (spin, rotation) {
+            bodies.turning(i, spin.0, rotation.0);
+        }
+        if own_friction {
+            bodies.friction.push(friction.map_or(f64::NAN, |own| own.0));
+        }
+    }
+}
+
+/// Each circle's new spin and rotation from `bodies`, written only where they changed.
+fn write_back_spin(bodies: &Bodies, entities: &[Entity], spins: &mut SpinCircles) {
+    for (i, &entity) in entities.iter().enumerate() {
+        let Ok((Some(mut spin), Some(mut rotation), ..)) = spins.get_mut(entity) else {
+            continue;
+        };
+        let (w, angle) = (bodies.angular_velocity[i], bodies.rotation[i]);
+        if spin.0 != w {
+            spin.0 = w;
+        }
+        if rotation.0 != angle {
+            rotation.0 = angle;
         }
     }
 }

@@ -14,13 +14,16 @@ use bevy::math::DVec2;
 
 use super::bodies::{Bodies, Softness};
 use super::cache::ContactCache;
-use super::contacts::{Constraint, ContactRules, ContactScratch, Partner, find_contacts};
+use super::contacts::{
+    Constraint, ContactRules, ContactScratch, TurningRow, find_contacts, may_turn, turning_rows,
+};
 use super::friction::{solve_turning, turn, warm_start_turning};
+use super::stats::{SoftStats, count};
 use crate::arena::Arena;
 use crate::boundary::put_back_inside;
 use crate::config::{Combine, SoftConfig};
 use crate::grid::NONE;
-use crate::hits::{CircleHit, HitLog, WallHit};
+use crate::hits::HitLog;
 use crate::segment::{Segment, SegmentCells};
 
 /// What one `soft` step is asked to do besides moving the circles.
@@ -48,32 +51,13 @@ pub struct SoftParams {
     pub config: SoftConfig,
 }
 
-/// What one `soft` step did.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SoftStats {
-    /// Circle contacts that began to push this step: collisions.
-    pub collisions: u64,
-    /// `Σ (r_a + r_b) · j` over every impulse between circles (the virial, for the pressure).
-    pub virial: f64,
-    /// Work immovable circles did on movable ones: each push times the pusher's velocity along
-    /// it (a static peg does none, a kinematic paddle what it injects).
-    pub immovable_work: f64,
-    /// Momentum immovable circles gave movable ones.
-    pub immovable_impulse: DVec2,
-    /// Wall contacts that began to push this step: wall hits.
-    pub wall_hits: u64,
-    /// Momentum the walls took up.
-    pub wall_impulse: f64,
-    /// Contacts solved (pairs and walls).
-    pub contacts: usize,
-}
-
 /// Buffers reused from step to step.
 #[derive(Default)]
 pub struct SoftScratch {
     contacts: ContactScratch,
     pairs: Vec<Constraint>,
     walls: Vec<Constraint>,
+    rows: Vec<TurningRow>,
 }
 
 /// Advances `bodies` by one step of `params.dt` in `arena` among `segments` (with the cells
@@ -150,18 +134,6 @@ fn parts_needed(bodies: &Bodies, params: &SoftParams) -> u32 {
     }
 }
 
-impl SoftStats {
-    fn add(&mut self, other: &SoftStats) {
-        self.collisions += other.collisions;
-        self.virial += other.virial;
-        self.immovable_work += other.immovable_work;
-        self.immovable_impulse += other.immovable_impulse;
-        self.wall_hits += other.wall_hits;
-        self.wall_impulse += other.wall_impulse;
-        self.contacts = self.contacts.max(other.contacts);
-    }
-}
-
 /// One part of a step: contacts, substeps, restitution, store.
 fn soft_part(
     bodies: &mut Bodies,
@@ -196,22 +168,36 @@ fn soft_part(
         contacts,
         pairs,
         walls,
+        rows,
     } = scratch;
     find_contacts(bodies, arena, segments, &rules, contacts, (pairs, walls));
-    cache.warm_start(&bodies.id, walls);
-    cache.warm_start(&bodies.id, pairs);
+    rows.clear();
+    if may_turn(bodies, &rules) {
+        bodies.start_turning();
+        turning_rows(
+            bodies,
+            &rules,
+            walls.iter_mut().chain(pairs.iter_mut()),
+            rows,
+        );
+    }
+    cache.warm_start(&bodies.id, walls, rows);
+    cache.warm_start(&bodies.id, pairs, rows);
     let mut work = Work::default();
+    let rows_empty = rows.is_empty();
     let (dv, drag) = (params.gravity * h, (-params.drag * h).exp());
     for _ in 0..substeps {
         integrate_velocities(bodies, dv, drag);
-        warm_start(bodies, walls, pairs, &mut work);
-        solve(bodies, (walls, pairs), inv_h, true, &mut work);
-        integrate_positions(bodies, h);
-        turn(bodies, h);
-        solve(bodies, (walls, pairs), inv_h, false, &mut work);
+        // A step without friction runs its passes without looking for turning rows at all.
+        let contacts = (&mut walls[..], &mut pairs[..], &mut rows[..]);
+        if rows_empty {
+            substep::<false>(bodies, contacts, h, &mut work);
+        } else {
+            substep::<true>(bodies, contacts, h, &mut work);
+        }
     }
     restitution(bodies, (walls, pairs), &mut work);
-    cache.store(&bodies.id, walls.iter().chain(pairs.iter()));
+    cache.store(&bodies.id, walls.iter().chain(pairs.iter()), rows);
     keep_inside(bodies, arena);
     let mut stats = SoftStats {
         immovable_work: work.energy,
@@ -221,6 +207,21 @@ fn soft_part(
     };
     count(bodies, (walls, pairs), params.dt, &mut stats, hits);
     stats
+}
+
+/// One substep: warm start, solve with the soft push-out, move and turn, relax (the turning
+/// rows' part of each pass only with `TURNING`).
+fn substep<const TURNING: bool>(
+    bodies: &mut Bodies,
+    (walls, pairs, rows): (&mut [Constraint], &mut [Constraint], &mut [TurningRow]),
+    h: f64,
+    work: &mut Work,
+) {
+    warm_start::<TURNING>(bodies, (walls, pairs), rows, work);
+    solve::<TURNING>(bodies, (walls, pairs, rows), 1.0 / h, true, work);
+    integrate_positions(bodies, h);
+    turn(bodies, h);
+    solve::<TURNING>(bodies, (walls, pairs, rows), 1.0 / h, false, work);
 }
 
 /// The work immovable circles did on movable ones through their contacts' impulses, and the
@@ -278,10 +279,10 @@ fn apply(bodies: &mut Bodies, c: &Constraint, j: f64, work: &mut Work) {
 
 /// Applies each contact's impulse from the last substep (or step) again: the solve then only
 /// corrects it.
-fn warm_start(
+fn warm_start<const TURNING: bool>(
     bodies: &mut Bodies,
-    walls: &mut [Constraint],
-    pairs: &mut [Constraint],
+    (walls, pairs): (&mut [Constraint], &mut [Constraint]),
+    rows: &[TurningRow],
     work: &mut Work,
 ) {
     for c in walls.iter_mut().chain(pairs.iter_mut()) {
@@ -289,8 +290,8 @@ fn warm_start(
             apply(bodies, c, c.impulse, work);
             c.total_impulse += c.impulse;
         }
-        if c.friction > 0.0 {
-            work.add(warm_start_turning(bodies, c));
+        if TURNING && c.turn != NONE {
+            work.add(warm_start_turning(bodies, c, &rows[c.turn as usize]));
         }
     }
 }
@@ -311,9 +312,9 @@ fn other_side(bodies: &Bodies, c: &Constraint) -> (DVec2, DVec2) {
 /// contact's push speed); without it (the relax pass) only approach is stopped. Either way a
 /// gap still open lets the pair approach by as much as closes it within the substep: the
 /// speculative part that keeps fast circles from tunnelling.
-fn solve(
+fn solve<const TURNING: bool>(
     bodies: &mut Bodies,
-    (walls, pairs): (&mut [Constraint], &mut [Constraint]),
+    (walls, pairs, rows): (&mut [Constraint], &mut [Constraint], &mut [TurningRow]),
     inv_h: f64,
     use_bias: bool,
     work: &mut Work,
@@ -337,8 +338,8 @@ fn solve(
         c.impulse = total;
         c.total_impulse += j;
         apply(bodies, c, j, work);
-        if c.friction > 0.0 {
-            work.add(solve_turning(bodies, c));
+        if TURNING && c.turn != NONE {
+            work.add(solve_turning(bodies, c, &mut rows[c.turn as usize]));
         }
     }
 }
@@ -386,53 +387,6 @@ fn keep_inside(bodies: &mut Bodies, arena: &Arena) {
             *p = arena.wrap(*p);
         } else {
             put_back_inside(p, r, arena);
-        }
-    }
-}
-
-/// Counts the step's collisions and wall hits (contacts that began to push), the virial and
-/// the walls' momentum, and records the hits.
-fn count(
-    bodies: &Bodies,
-    (walls, pairs): (&[Constraint], &[Constraint]),
-    dt: f64,
-    stats: &mut SoftStats,
-    mut hits: Option<&mut HitLog>,
-) {
-    for c in pairs {
-        stats.virial += c.reach * c.total_impulse;
-        if c.total_impulse > 0.0 && !c.was_touching {
-            stats.collisions += 1;
-            if let Some(log) = hits.as_deref_mut() {
-                let a = c.a as usize;
-                log.circles.push(CircleHit {
-                    a: c.a,
-                    b: c.b,
-                    point: bodies.position[a] + c.normal * bodies.radius[a],
-                    normal: c.normal,
-                    impulse: c.total_impulse,
-                    normal_speed: c.approach.max(-c.relative_velocity),
-                    time: dt,
-                });
-            }
-        }
-    }
-    for c in walls {
-        stats.wall_impulse += c.total_impulse;
-        if c.total_impulse > 0.0 && !c.was_touching {
-            stats.wall_hits += 1;
-            if let (Some(log), Partner::Wall(wall)) = (hits.as_deref_mut(), c.partner) {
-                log.walls.push(WallHit {
-                    circle: c.a,
-                    wall,
-                    point: c.anchor,
-                    normal: c.normal,
-                    impulse: c.total_impulse,
-                    normal_speed: c.approach.max(-c.relative_velocity),
-                    time: dt,
-                    count: 1,
-                });
-            }
         }
     }
 }
