@@ -375,3 +375,29 @@ fn a_circle_spinning_in_place_is_not_at_rest_and_does_not_fall_asleep() {
     assert!(!asleep(&app, top), "the spinning circle fell asleep");
     assert_eq!(spin(&app, top), 5.0);
 }
+
+#[test]
+fn a_spinning_kinematic_wheel_drives_a_ball_resting_on_it_and_its_work_is_counted() {
+    // A wheel (immovable, turning counter-clockwise) whose top moves to the left carries a
+    // ball resting on it to the left; the work it does is what the ball gains, less friction.
+    let mut app = create_app(rough(0.5, 0.0, Vec::new()));
+    let wheel = app
+        .world_mut()
+        .spawn((
+            Radius(1.0),
+            Position(DVec2::ZERO),
+            Mass::IMMOVABLE,
+            AngularVelocity(2.0),
+        ))
+        .id();
+    let ball = spawn_circle(&mut app, DVec2::new(0.0, 1.3), DVec2::ZERO, 0.3, 1.0);
+    step(&mut app, 20);
+    let (p, v) = state(&app, ball);
+    assert!(
+        v.x < -0.1 && p.x < -0.01,
+        "the ball was not carried left: {p} {v}"
+    );
+    assert_eq!(spin(&app, wheel), 2.0, "nothing turns a kinematic wheel");
+    let work = app.world().resource::<PairCollisions>().immovable_work;
+    assert!(work > 0.0, "the wheel did no work: {work}");
+}
