@@ -5,7 +5,6 @@
 //! a compact binary form (postcard); read back with a size limit and every value checked, so a
 //! damaged or forged file is an error naming the file, never a panic.
 
-use std::f64::consts::PI;
 use std::path::Path;
 
 use bevy::prelude::*;
@@ -24,8 +23,9 @@ use crate::error::InputError;
 use crate::exact::EngineState;
 use crate::exact::engine::EngineSnapshot;
 use crate::io::read_bytes_limited;
-use crate::range::{check_magnitude, check_mass, check_vector};
+use crate::range::{check_mass, check_vector};
 use crate::run::{Progress, headless_app};
+use crate::scene::check::check_spin;
 use crate::schedule::StepTotals;
 use crate::segment::Segments;
 use crate::sleep::Sleeping;
@@ -230,14 +230,11 @@ impl Checkpoint {
                     c.radius
                 ));
             }
-            // A rotation is kept in [-π, π]; a surface may turn no faster than any speed.
-            let (angle, w) = (c.rotation, c.angular_velocity);
-            if !(-PI..=PI).contains(&angle) || check_magnitude("", w * c.radius).is_err() {
-                return Err(format!(
-                    "circle {i} has rotation {angle:?}, angular velocity {w:?}"
-                ));
-            }
+            check_spin(c)
+                .map_err(|e| e.within(&format!("circles[{i}]")))
+                .map_err(describe)?;
             // A circle asleep does not turn (it would drive its neighbours like a wheel).
+            let w = c.angular_velocity;
             if self.sleep[i].asleep && w != 0.0 {
                 return Err(format!("circle {i} is asleep but turns at {w:?}"));
             }
@@ -404,6 +401,12 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("asleep but turns"), "{error}");
+        let mut spun = good.clone();
+        spun.circles[2].rotation = 4.0;
+        let error = Checkpoint::from_bytes(&spun.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("rotation"), "{error}");
     }
 
     #[test]

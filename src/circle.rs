@@ -48,14 +48,6 @@ impl CircleState {
         }
     }
 
-    /// The same circle turning at `angular_velocity`.
-    pub fn with_spin(self, angular_velocity: f64) -> Self {
-        Self {
-            angular_velocity,
-            ..self
-        }
-    }
-
     /// The same circle with another mass.
     pub fn with_mass(self, mass: f64) -> Self {
         Self { mass, ..self }

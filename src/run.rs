@@ -17,7 +17,7 @@ use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, discs, snapshot};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::components::{AngularVelocity, Mass, Position, Radius, Sleep, Velocity};
+use crate::components::Sleep;
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
@@ -196,18 +196,11 @@ fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl Fn
 
 /// Mechanical energy, momentum and counts of the world's circles under its arena and gravity.
 fn totals(world: &mut World) -> Totals {
-    let mut circles = world.query::<(
-        &Position,
-        &Velocity,
-        &Mass,
-        &Radius,
-        Option<&AngularVelocity>,
-    )>();
-    let spin = |w: Option<&AngularVelocity>| w.map_or(0.0, |w| w.0);
+    let circles = snapshot(world);
     Totals::measure(
         circles
-            .iter(world)
-            .map(|(p, v, m, r, w)| (p.0, v.0, m.0, r.0, spin(w))),
+            .iter()
+            .map(|c| (c.position, c.velocity, c.mass, c.radius, c.angular_velocity)),
         world.resource::<Arena>(),
         world.resource::<Effects>().gravity,
     )

@@ -4,6 +4,7 @@
 //! arena ([`check_circle`]) and none overlapping another beyond rounding ([`first_overlap`]).
 //! Every error names the file and the field.
 
+use std::f64::consts::PI;
 use std::ops::ControlFlow;
 use std::path::Path;
 
@@ -171,6 +172,23 @@ fn polyline_of(polylines: &[Vec<DVec2>], mut k: usize) -> (usize, usize) {
     (polylines.len(), k)
 }
 
+/// Checks how a circle turns: its rotation in `[-π, π]` (where every solver keeps it) and its
+/// surface no faster than any speed an input may give.
+pub fn check_spin(c: &CircleState) -> Result<(), FieldError> {
+    if !(-PI..=PI).contains(&c.rotation) {
+        let why = format!("must be in [-π, π], got {:?}", c.rotation);
+        return Err(FieldError::new("rotation", why));
+    }
+    if check_magnitude("", c.angular_velocity * c.radius).is_err() {
+        let why = format!(
+            "must be finite, its surface no faster than {MAX_MAGNITUDE:e}, got {:?}",
+            c.angular_velocity
+        );
+        return Err(FieldError::new("angular_velocity", why));
+    }
+    Ok(())
+}
+
 /// Checks one explicit circle: finite, positive radius, a mass in range or infinite (a static
 /// circle, which must be at rest), inside the arena (entirely, with walls; its centre, when
 /// periodic; anywhere, when open), not larger than it.
@@ -193,14 +211,7 @@ pub fn check_circle(c: &CircleState, arena: &Arena) -> Result<(), FieldError> {
     if c.mass != f64::INFINITY {
         check_mass("mass", c.mass)?;
     }
-    // Its surface may turn no faster than any speed an input gives.
-    if check_magnitude("", c.angular_velocity * c.radius).is_err() {
-        let why = format!(
-            "must be finite, its surface no faster than {MAX_MAGNITUDE:e}, got {:?}",
-            c.angular_velocity
-        );
-        return Err(FieldError::new("angular_velocity", why));
-    }
+    check_spin(c)?;
     if c.radius < min_radius(arena) {
         return Err(FieldError::new(
             "radius",

@@ -262,16 +262,16 @@ impl CacheSnapshot {
             .enumerate()
             .flat_map(|(i, &count)| std::iter::repeat_n(i, count as usize));
         for (i, e) in owners.zip(&self.entries) {
-            let other = match e.partner {
-                SnapshotPartner::Circle(k) => &circles[k as usize],
-                SnapshotPartner::Wall(_) => &circles[i],
+            let own = &circles[i];
+            let (other, smaller) = match e.partner {
+                SnapshotPartner::Circle(k) => {
+                    let other = &circles[k as usize];
+                    (other.inv_mass(), own.radius.min(other.radius))
+                }
+                SnapshotPartner::Wall(_) => (0.0, own.radius),
             };
-            let lightest = circles[i].inv_mass().max(match e.partner {
-                SnapshotPartner::Circle(_) => other.inv_mass(),
-                SnapshotPartner::Wall(_) => 0.0,
-            });
+            let lightest = own.inv_mass().max(other);
             // A torque impulse k turns a uniform disc's surface by 2 k w / r.
-            let smaller = circles[i].radius.min(other.radius);
             let turning = 2.0 * e.rolling.abs() * lightest / smaller;
             for (what, change) in [
                 ("contact impulse", e.impulse * lightest),

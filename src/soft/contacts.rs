@@ -159,29 +159,27 @@ pub fn turning_rows<'a>(
     for c in contacts {
         let i = c.a as usize;
         let own = |k: usize| bodies.own_friction(k);
-        let (friction, other) = if c.b == NONE {
+        // Friction, the other side's inverse inertia, the levers and the smaller radius.
+        let (friction, ib, lever, smaller) = if c.b == NONE {
             // The walls' coefficient is that of a circle against them; a circle's own meets it.
             let walls = rules.friction.1;
             let friction = own(i).map_or(walls, |own| rules.combine.apply(own, walls));
-            (friction, None)
+            let r = bodies.radius[i];
+            (friction, 0.0, (r, 0.0), r)
         } else {
             let j = c.b as usize;
             let scene = rules.friction.0;
             let friction = rules
                 .combine
                 .apply(own(i).unwrap_or(scene), own(j).unwrap_or(scene));
-            (friction, Some(j))
+            let lever = (bodies.radius[i], bodies.radius[j]);
+            (friction, bodies.inv_inertia[j], lever, lever.0.min(lever.1))
         };
         if friction <= 0.0 || friction.is_nan() {
             continue;
         }
         let (wa, wb) = c.inv_mass;
         let ia = bodies.inv_inertia[i];
-        let (ib, lever) = match other {
-            Some(j) => (bodies.inv_inertia[j], (bodies.radius[i], bodies.radius[j])),
-            None => (0.0, (bodies.radius[i], 0.0)),
-        };
-        let smaller = lever.0.min(if other.is_some() { lever.1 } else { lever.0 });
         let spin = ia + ib;
         let rolling = rules.rolling_resistance * smaller;
         let rolling_mass = if spin > 0.0 && rolling > 0.0 {

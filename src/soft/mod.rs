@@ -25,7 +25,7 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
-use crate::components::{Friction, Restitution, Sleep, SolverCircles, SpinCircles};
+use crate::components::{Friction, Restitution, SolverCircles, SpinCircles};
 use crate::config::{Effects, SoftConfig, Solver};
 use crate::hits::{CircleHit, HitLog, WallHit};
 use crate::schedule::{CircleSystems, SoftStep, StepDt};
@@ -219,18 +219,14 @@ fn step_soft(
     }
 }
 
-/// What a circle the spin query does not see has: it does not turn.
-const SLEEP: Sleep = Sleep {
-    anchor: DVec2::ZERO,
-    slow_for: 0.0,
-    asleep: false,
-};
-
 /// Each circle's spin (and own friction, when `own_friction`) into `bodies`, by entity.
 fn gather_spin(bodies: &mut Bodies, entities: &[Entity], spins: &SpinCircles, own_friction: bool) {
     bodies.start_turning();
     for (i, &entity) in entities.iter().enumerate() {
-        let (spin, rotation, friction, _) = spins.get(entity).unwrap_or((None, None, None, &SLEEP));
+        let (spin, rotation, friction) = match spins.get(entity) {
+            Ok((spin, rotation, friction, _)) => (spin, rotation, friction),
+            Err(_) => (None, None, None),
+        };
         if let (Some(spin), Some(rotation)) = (spin, rotation) {
             bodies.turning(i, spin.0, rotation.0);
         }
