@@ -7,6 +7,41 @@ use bevy::prelude::*;
 
 use crate::components::{AngularVelocity, Mass, Position, Radius, Rotation, Tint, Velocity};
 
+/// The moment of inertia of a uniform disc of `mass` and `radius` about its centre: `m r² / 2`,
+/// what every circle turns with.
+#[inline]
+pub fn disc_inertia(mass: f64, radius: f64) -> f64 {
+    0.5 * mass * radius * radius
+}
+
+/// [`disc_inertia`]'s inverse from the inverse mass: `2 w / r²`; 0 for a circle that cannot
+/// turn: immovable (`w = 0`), or so small that `r²` underflows (rather than infinitely easy to
+/// turn).
+#[inline]
+pub fn disc_inverse_inertia(inv_mass: f64, radius: f64) -> f64 {
+    let inverse = 2.0 * inv_mass / (radius * radius);
+    if inverse.is_finite() { inverse } else { 0.0 }
+}
+
+/// The moment of inertia a circle turns with: its `own`
+/// ([`Inertia`](crate::components::Inertia)) or a uniform disc's.
+#[inline]
+pub fn inertia(own: Option<f64>, mass: f64, radius: f64) -> f64 {
+    own.unwrap_or_else(|| disc_inertia(mass, radius))
+}
+
+/// [`inertia`]'s inverse from the inverse mass: 0 for a circle that does not turn from a
+/// push: immovable (`w = 0`), or of an own inertia that is infinite or not above 0.
+#[inline]
+pub fn inverse_inertia(own: Option<f64>, inv_mass: f64, radius: f64) -> f64 {
+    match own {
+        _ if inv_mass == 0.0 => 0.0,
+        Some(i) if i > 0.0 => 1.0 / i,
+        Some(_) => 0.0,
+        None => disc_inverse_inertia(inv_mass, radius),
+    }
+}
+
 /// The state of one circle.
 ///
 /// ```

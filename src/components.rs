@@ -124,6 +124,23 @@ impl Rotation {
     }
 }
 
+/// A circle's own moment of inertia about its centre (kg·m²): a hollow ring (`m r²`), a ball
+/// with a heavy core, a wheel. Without it a circle turns as a uniform disc of its mass and
+/// radius, `m r² / 2`. Contacts with friction (`soft`) and rough hits (`swept`, `exact`) turn
+/// it through this; `f64::INFINITY` (or any value not above 0) keeps it from turning at all.
+///
+/// ```
+/// use bevy::prelude::*;
+/// use moving_circles::prelude::*;
+///
+/// let mut world = World::new();
+/// // A ring of mass 1 and radius 0.5: all its mass at the rim.
+/// world.spawn((Radius(0.5), Mass(1.0), Inertia(0.25)));
+/// ```
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
+#[reflect(Component, Debug)]
+pub struct Inertia(pub f64);
+
 /// A circle's own friction coefficient (Coulomb's μ, 0 or more); without it a circle takes
 /// the scene's (`effects.friction` against circles, `effects.wall_friction` against walls).
 /// Two values meet as the scene's `effects.friction_combine` says (their geometric mean by
@@ -180,8 +197,8 @@ pub type SolverCircles<'w, 's> = Query<
 
 /// How circles turn, as the solvers read and write it, in a query of its own so that a step
 /// in which nothing turns pays nothing for it: each circle's angular velocity and rotation
-/// (either may be absent: the circle then does not turn), its own friction, and whether it
-/// sleeps.
+/// (either may be absent: the circle then does not turn), its own friction and moment of
+/// inertia, and whether it sleeps.
 pub type SpinCircles<'w, 's> = Query<
     'w,
     's,
@@ -189,6 +206,7 @@ pub type SpinCircles<'w, 's> = Query<
         Option<&'static mut AngularVelocity>,
         Option<&'static mut Rotation>,
         Option<&'static Friction>,
+        Option<&'static Inertia>,
         &'static Sleep,
     ),
     With<Radius>,

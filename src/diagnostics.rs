@@ -9,8 +9,9 @@ use bevy::prelude::*;
 
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
+use crate::circle::inertia;
 use crate::collide::PairCollisions;
-use crate::components::{AngularVelocity, Mass, Position, Radius, Velocity};
+use crate::components::{AngularVelocity, Inertia, Mass, Position, Radius, Velocity};
 use crate::config::Effects;
 use crate::schedule::{CircleSystems, StepTotals};
 use crate::spawn::SpawnReport;
@@ -134,10 +135,10 @@ pub struct Totals {
 }
 
 impl Totals {
-    /// Measures circles given as `(position, velocity, mass, radius, angular velocity)`.
-    /// Immovable (infinite-mass) circles carry no energy or momentum.
+    /// Measures circles given as `(position, velocity, mass, (angular velocity, moment of
+    /// inertia))`. Immovable (infinite-mass) circles carry no energy or momentum.
     pub fn measure(
-        circles: impl Iterator<Item = (DVec2, DVec2, f64, f64, f64)>,
+        circles: impl Iterator<Item = (DVec2, DVec2, f64, (f64, f64))>,
         arena: &Arena,
         gravity: Option<DVec2>,
     ) -> Self {
@@ -146,7 +147,7 @@ impl Totals {
         // negative and a relative drift stays meaningful.
         let floor = DVec2::select(g.cmpgt(DVec2::ZERO), arena.max, arena.min);
         let mut totals = Self::default();
-        for (p, v, m, r, w) in circles {
+        for (p, v, m, (w, inertia)) in circles {
             totals.count += 1;
             if !(p.is_finite() && v.is_finite() && w.is_finite()) {
                 totals.non_finite += 1;
@@ -157,11 +158,9 @@ impl Totals {
             if !m.is_finite() {
                 continue;
             }
-            let (p, v, m) = (p, v, m);
             totals.kinetic_energy += 0.5 * m * v.length_squared();
             totals.potential_energy += m * g.dot(floor - p);
             totals.momentum += m * v;
-            let inertia = 0.5 * m * r * r;
             totals.angular_momentum += m * p.perp_dot(v);
             if w != 0.0 {
                 totals.rotational_energy += 0.5 * inertia * w * w;
@@ -217,24 +216,33 @@ impl Plugin for DiagnosticsPlugin {
     }
 }
 
+/// What the diagnostics read of each circle.
+type MeasuredCircles<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static Position,
+        &'static Velocity,
+        &'static Mass,
+        &'static Radius,
+        Option<&'static AngularVelocity>,
+        Option<&'static Inertia>,
+    ),
+>;
+
 /// Updates [`CircleDiagnostics`] from the circles.
 fn measure(
     arena: Res<Arena>,
     effects: Res<Effects>,
     mut diagnostics: ResMut<CircleDiagnostics>,
-    circles: Query<(
-        &Position,
-        &Velocity,
-        &Mass,
-        &Radius,
-        Option<&AngularVelocity>,
-    )>,
+    circles: MeasuredCircles,
 ) {
     let spin = |w: Option<&AngularVelocity>| w.map_or(0.0, |w| w.0);
     let totals = Totals::measure(
-        circles
-            .iter()
-            .map(|(p, v, m, r, w)| (p.0, v.0, m.0, r.0, spin(w))),
+        circles.iter().map(|(p, v, m, r, w, own)| {
+            let turning = (spin(w), inertia(own.map(|i| i.0), m.0, r.0));
+            (p.0, v.0, m.0, turning)
+        }),
         &arena,
         effects.gravity,
     );

@@ -16,6 +16,7 @@ impl Plugin for IntegratePlugin {
             .register_type::<Velocity>()
             .register_type::<Rotation>()
             .register_type::<AngularVelocity>()
+            .register_type::<crate::components::Inertia>()
             .add_systems(
                 CircleStep,
                 integrate_positions.in_set(CircleSystems::Integrate),
@@ -58,7 +59,7 @@ pub fn turn_circles(circles: &mut SpinCircles, dt: f64) {
     if !circles.iter().any(|(w, ..)| w.is_some_and(|w| w.0 != 0.0)) {
         return;
     }
-    for (spin, rotation, _, sleep) in circles.iter_mut() {
+    for (spin, rotation, _, _, sleep) in circles.iter_mut() {
         let (Some(mut spin), Some(mut rotation)) = (spin, rotation) else {
             continue;
         };

@@ -215,8 +215,8 @@ pub mod prelude {
     pub use crate::circle::CircleState;
     pub use crate::collide::{CollidePlugin, PairCollisions};
     pub use crate::components::{
-        AngularVelocity, Friction, Mass, Position, Radius, Restitution, Rotation, Sleep, Tint,
-        Velocity,
+        AngularVelocity, Friction, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep,
+        Tint, Velocity,
     };
     pub use crate::config::{
         CirclesConfig, Combine, DropConfig, Effects, MassModel, Placement, SleepConfig, SoftConfig,
@@ -239,7 +239,8 @@ pub mod prelude {
 }
 
 pub use components::{
-    AngularVelocity, Friction, Mass, Position, Radius, Restitution, Rotation, Tint, Velocity,
+    AngularVelocity, Friction, Inertia, Mass, Position, Radius, Restitution, Rotation, Tint,
+    Velocity,
 };
 pub use schedule::CircleSystems;
 

@@ -14,10 +14,10 @@ use serde::{Deserialize, Serialize};
 use crate::CirclesPlugins;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, discs, snapshot};
+use crate::circle::{CircleState, discs, inertia, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::components::Sleep;
+use crate::components::{Inertia, Sleep};
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
@@ -196,11 +196,13 @@ fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl Fn
 
 /// Mechanical energy, momentum and counts of the world's circles under its arena and gravity.
 fn totals(world: &mut World) -> Totals {
-    let circles = snapshot(world);
+    let circles = snapshot_with_entities(world);
+    let own = |e: Entity| world.get::<Inertia>(e).map(|i| i.0);
     Totals::measure(
-        circles
-            .iter()
-            .map(|c| (c.position, c.velocity, c.mass, c.radius, c.angular_velocity)),
+        circles.iter().map(|&(e, c)| {
+            let turning = (c.angular_velocity, inertia(own(e), c.mass, c.radius));
+            (c.position, c.velocity, c.mass, turning)
+        }),
         world.resource::<Arena>(),
         world.resource::<Effects>().gravity,
     )

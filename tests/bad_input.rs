@@ -74,6 +74,18 @@ fn effect_parameters_are_checked() {
         &scene_error("(effects: (drag: -1.0))"),
         "bad.ron: field `effects.drag`",
     );
+    for (field, value) in [
+        ("friction", "-0.1"),
+        ("rolling_resistance", "1e300"),
+        ("tangential_restitution", "1.5"),
+        ("wall_tangential_restitution", "-1.01"),
+        ("tangential_restitution", "NaN"),
+    ] {
+        assert_starts(
+            &scene_error(&format!("(effects: ({field}: {value}))")),
+            &format!("bad.ron: field `effects.{field}`"),
+        );
+    }
     assert_starts(&scene_error("(mass: Equal(0.0))"), "bad.ron: field `mass`");
 }
 

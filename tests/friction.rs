@@ -2,7 +2,8 @@
 //! disc (moment of inertia m r² / 2): rolling down a slope at (2/3) g sin θ, slipping at
 //! g (sin θ − μ cos θ) below the friction threshold, a disc launched sliding that starts to roll
 //! at t = v₀ / (3 μ g) with 2/3 of its speed, rolling resistance's steady deceleration, and
-//! spin passed between two circles within the Coulomb bound, momentum kept.
+//! spin passed between two circles within the Coulomb bound, momentum kept; a circle of its own
+//! moment of inertia (a ring) rolls as its inertia says.
 
 mod common;
 
@@ -45,6 +46,11 @@ fn spin(app: &App, e: Entity) -> f64 {
 /// acceleration along the slope, measured between 0.25 s and 1.25 s, and its rolling ratio
 /// `-ω r / v` at the end (1 when it rolls without slipping).
 fn down_the_slope(degrees: f64, mu: f64) -> (f64, f64) {
+    down_the_slope_with(degrees, mu, None)
+}
+
+/// [`down_the_slope`] for a circle of its `own` moment of inertia.
+fn down_the_slope_with(degrees: f64, mu: f64, own: Option<Inertia>) -> (f64, f64) {
     let theta = degrees.to_radians();
     let down = DVec2::new(theta.cos(), -theta.sin());
     let (top, r) = (DVec2::new(-60.0, 30.0), 0.5);
@@ -53,6 +59,9 @@ fn down_the_slope(degrees: f64, mu: f64) -> (f64, f64) {
     // On the slope's upper side, touching it, 5 m down from its top.
     let up = DVec2::new(theta.sin(), theta.cos());
     let ball = spawn_circle(&mut app, top + down * 5.0 + up * r, DVec2::ZERO, r, 1.0);
+    if let Some(own) = own {
+        app.world_mut().entity_mut(ball).insert(own);
+    }
     step(&mut app, 15);
     let v1 = state(&app, ball).1.dot(down);
     step(&mut app, 60);
@@ -76,6 +85,19 @@ fn a_disc_with_enough_friction_rolls_down_a_slope_at_two_thirds_of_g_sin_theta()
             expected,
             0.01,
         );
+        assert_relative("rolling ratio -ω r / v", rolling, 1.0, 0.01);
+    }
+}
+
+#[test]
+fn a_ring_rolls_down_a_slope_at_half_of_g_sin_theta_and_a_heavy_core_faster() {
+    // Rolling, a circle of moment of inertia I accelerates at g sin θ / (1 + I / (m r²)): a
+    // ring (I = m r²) at half of g sin θ, a ball with a heavy core (I = m r² / 5) at 5/6.
+    for (inertia, share) in [(0.25, 0.5), (0.05, 5.0 / 6.0)] {
+        let (a, rolling) = down_the_slope_with(30.0, 0.8, Some(Inertia(inertia)));
+        let expected = share * G * f64::to_radians(30.0).sin();
+        println!("I = {inertia}: a {a:.5}, analytic {expected:.5}, -ωr/v {rolling:.5}");
+        assert_relative(&format!("acceleration, I = {inertia}"), a, expected, 0.01);
         assert_relative("rolling ratio -ω r / v", rolling, 1.0, 0.01);
     }
 }

@@ -68,6 +68,8 @@ fn a_resumed_run_ends_bit_for_bit_where_the_whole_run_ends_under_every_solver() 
         // Friction: spin, and friction impulses warm started across each pause.
         ("assets/scenes/slope.ron", &["soft", "exact"][..]),
         ("assets/scenes/repose.ron", &["soft"][..]),
+        // Rough hits: spin and rotation kept in the engine across each pause.
+        ("assets/scenes/rough_gas.ron", &["swept", "exact"][..]),
     ];
     for (scene, solvers) in runs {
         for &solver in solvers {

@@ -1,4 +1,4 @@
-//! [`Effects`]: which effects a scene calls for and their parameters (restitution, friction,
+//! [`Effects`]: which effects a scene calls for and their parameters (restitution, roughness, friction,
 //! gravity, drag, collision messages, sleeping), with the one `check` scenes and the command
 //! line use; [`Combine`], how two circles' friction meets; and [`SleepConfig`], when circles
 //! at rest fall asleep.
@@ -41,6 +41,14 @@ pub struct Effects {
     /// of this times its contact's push times its radius (the smaller radius of two circles),
     /// so a ball rolling on a floor stops after a while. Under `soft`, with friction.
     pub rolling_resistance: f64,
+    /// Tangential restitution β between circles, from −1 to 1: how rough their hits are under
+    /// the event solvers `swept` and `exact`. At each hit the slip of the two surfaces at the
+    /// contact becomes −β times what it was, trading energy between moving and turning: −1,
+    /// the default, is smooth (no spin traded), +1 perfectly rough (no energy lost when the
+    /// restitution is 1 too). The contact solver `soft` has friction instead.
+    pub tangential_restitution: f64,
+    /// Tangential restitution β between a circle and a wall (arena or segment wall).
+    pub wall_tangential_restitution: f64,
     /// Write a [`CircleHit`](crate::hits::CircleHit) message per circle-circle impulse and a
     /// [`WallHit`](crate::hits::WallHit) per wall hit, under every solver. Off, nothing is
     /// recorded.
@@ -132,6 +140,8 @@ impl Default for Effects {
             wall_friction: 0.0,
             friction_combine: Combine::GeometricMean,
             rolling_resistance: 0.0,
+            tangential_restitution: -1.0,
+            wall_tangential_restitution: -1.0,
             hit_messages: false,
             sleep: SleepConfig::default(),
         }
@@ -144,9 +154,14 @@ impl Effects {
         self.friction > 0.0 || self.wall_friction > 0.0 || self.rolling_resistance > 0.0
     }
 
-    /// Whether every parameter is usable: restitutions in `[0, 1]`, friction coefficients and
-    /// rolling resistance from 0 to [`MAX_FRICTION`], finite gravity, a finite non-negative
-    /// drag rate.
+    /// Whether any hit is rough (a tangential restitution above −1).
+    pub fn is_rough(&self) -> bool {
+        self.tangential_restitution > -1.0 || self.wall_tangential_restitution > -1.0
+    }
+
+    /// Whether every parameter is usable: restitutions in `[0, 1]`, tangential restitutions in
+    /// `[-1, 1]`, friction coefficients and rolling resistance from 0 to [`MAX_FRICTION`],
+    /// finite gravity, a finite non-negative drag rate.
     pub fn check(&self) -> Result<(), FieldError> {
         let unit = |x: f64| x.is_finite() && (0.0..=1.0).contains(&x);
         if !unit(self.restitution) {
@@ -160,6 +175,22 @@ impl Effects {
                 "effects.wall_restitution",
                 format!("must be in [0, 1], got {}", self.wall_restitution),
             ));
+        }
+        let tangential = [
+            (
+                "effects.tangential_restitution",
+                self.tangential_restitution,
+            ),
+            (
+                "effects.wall_tangential_restitution",
+                self.wall_tangential_restitution,
+            ),
+        ];
+        for (field, value) in tangential {
+            if !(-1.0..=1.0).contains(&value) {
+                let why = format!("must be in [-1, 1] (-1 smooth, 1 perfectly rough), got {value}");
+                return Err(FieldError::new(field, why));
+            }
         }
         let coefficients = [
             ("effects.friction", self.friction),

@@ -5,6 +5,8 @@ use std::f64::consts::TAU;
 
 use bevy::math::DVec2;
 
+use crate::circle::inverse_inertia;
+
 /// The circles of one `soft` step, as plain arrays in one order (the solver's query's).
 #[derive(Clone, Debug, Default)]
 pub struct Bodies {
@@ -69,16 +71,18 @@ impl Bodies {
         }
     }
 
-    /// Lets circle `i` turn: at `angular_velocity`, from `rotation`, as a uniform disc (moment
-    /// of inertia `m r² / 2`) if it is movable. Call [`Bodies::start_turning`] first.
-    pub fn turning(&mut self, i: usize, angular_velocity: f64, rotation: f64) {
+    /// Lets circle `i` turn: at its angular velocity, from its rotation, with its `own` moment
+    /// of inertia or as a uniform disc (`m r² / 2`), if it is movable. Call
+    /// [`Bodies::start_turning`] first.
+    pub fn turning(
+        &mut self,
+        i: usize,
+        (angular_velocity, rotation): (f64, f64),
+        own: Option<f64>,
+    ) {
         self.angular_velocity[i] = angular_velocity;
         self.rotation[i] = rotation;
-        let r = self.radius[i];
-        let inverse = 2.0 * self.inv_mass[i] / (r * r);
-        // A radius so small its square underflows (an arena near the least size a float
-        // holds) leaves the circle unable to turn rather than infinitely easy to.
-        self.inv_inertia[i] = if inverse.is_finite() { inverse } else { 0.0 };
+        self.inv_inertia[i] = inverse_inertia(own, self.inv_mass[i], self.radius[i]);
     }
 
     /// Number of circles.

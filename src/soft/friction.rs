@@ -139,7 +139,7 @@ mod tests {
         let mut bodies = Bodies::default();
         bodies.push(1, DVec2::ZERO, DVec2::new(v, 0.0), 1.0, 1.0);
         bodies.start_turning();
-        bodies.turning(0, w, 0.0);
+        bodies.turning(0, (w, 0.0), None);
         let c = Constraint {
             a: 0,
             b: NONE,

@@ -223,12 +223,12 @@ fn step_soft(
 fn gather_spin(bodies: &mut Bodies, entities: &[Entity], spins: &SpinCircles, own_friction: bool) {
     bodies.start_turning();
     for (i, &entity) in entities.iter().enumerate() {
-        let (spin, rotation, friction) = match spins.get(entity) {
-            Ok((spin, rotation, friction, _)) => (spin, rotation, friction),
-            Err(_) => (None, None, None),
+        let (spin, rotation, friction, own) = match spins.get(entity) {
+            Ok((spin, rotation, friction, own, _)) => (spin, rotation, friction, own),
+            Err(_) => (None, None, None, None),
         };
         if let (Some(spin), Some(rotation)) = (spin, rotation) {
-            bodies.turning(i, spin.0, rotation.0);
+            bodies.turning(i, (spin.0, rotation.0), own.map(|i| i.0));
         }
         if own_friction {
             bodies.friction.push(friction.map_or(f64::NAN, |own| own.0));

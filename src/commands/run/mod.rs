@@ -59,6 +59,14 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
                     "note: friction acts under `soft` only; `{solver}` treats circles as smooth"
                 ));
             }
+            if config.effects.is_rough() && !matches!(config.solver, Solver::Swept | Solver::Exact)
+            {
+                let solver = config.solver;
+                say(format_args!(
+                    "note: rough hits (tangential restitution) act under `swept` and `exact` only; \
+                     `{solver}` treats circles as smooth"
+                ));
+            }
             let dt = config.dt;
             set_threads(options.threads);
             let Some(mut app) = start(config, &source, interrupts.stop_request())? else {

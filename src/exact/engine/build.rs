@@ -199,6 +199,7 @@ impl EventEngine {
             last_hit: vec![f64::NEG_INFINITY; n],
             quick_hits: vec![0; n],
             anchor: vec![(DVec2::INFINITY, 0.0); n],
+            spins: None,
         }
     }
 }

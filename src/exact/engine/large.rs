@@ -203,6 +203,7 @@ mod tests {
             &[],
             (1.0, 1.0),
             DVec2::ZERO,
+            crate::exact::engine::Roughness::SMOOTH,
         )
         .unwrap();
         original.advance_to(3.0, u64::MAX).unwrap();

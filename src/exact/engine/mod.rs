@@ -29,11 +29,13 @@ mod pairs;
 mod predict;
 mod rest;
 mod snapshot;
+mod spin;
 mod walls;
 
 pub use build::STOP_POLL_CIRCLES;
 pub use events::{BudgetExhausted, EventStats, Rest};
 pub use snapshot::EngineSnapshot;
+pub use spin::Roughness;
 
 use events::{BestPair, Event, Kind, Motion};
 use walls::{Layout, cell_width, walls_inside};
@@ -114,6 +116,8 @@ pub struct EventEngine {
     quick_hits: Vec<u32>,
     /// Where each circle last moved to, and when, while it bounces its least bounce.
     anchor: Vec<(DVec2, f64)>,
+    /// Each circle's turning, when hits are rough (`spin`); none when smooth.
+    spins: Option<spin::Spins>,
 }
 
 impl EventEngine {

@@ -1,6 +1,6 @@
 //! A pair collision: both circles brought to the moment of contact, a sleeping one woken if
 //! the hit is hard (or comes from an immovable mover) and otherwise treated as immovable, the
-//! restitution impulse, and a falling circle's bounce on a support checked for rest.
+//! restitution impulse (and a rough hit's tangential one, `spin`), and a falling circle's bounce on a support checked for rest.
 
 use bevy::math::DVec2;
 
@@ -36,11 +36,13 @@ impl EventEngine {
         if let Some(impulse) = apply_impulse(n, &mut va, &mut vb, wa, wb, bounce) {
             self.motion[i].vel = va;
             self.motion[j].vel = vb + surfaces;
+            let turning_work = self.rough_pair((i, j), n, (wa, wb));
             self.stats.pair_collisions += 1;
             self.stats.virial += (a.radius + b.radius) * impulse;
             if wa == 0.0 || wb == 0.0 {
+                let (va, vb) = (self.motion[i].vel, self.motion[j].vel - surfaces);
                 let (work, gained) = work_by_immovable((wa, wb), (a.vel, va), (b.vel, vb));
-                self.stats.immovable_work += work;
+                self.stats.immovable_work += work + turning_work;
                 self.stats.immovable_impulse += gained;
             }
             if let Some(log) = &mut self.hits {

@@ -81,6 +81,7 @@ impl EventEngine {
         self.falls[i] = false;
         self.quick_hits[i] = 0;
         self.motion[i].vel = DVec2::ZERO;
+        self.stop_turning(i);
     }
 
     /// Whether circle `i` flies a parabola: movable, awake, under gravity.

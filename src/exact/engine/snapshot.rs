@@ -8,9 +8,11 @@ use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::events::{BestPair, Event, EventStats, Kind, Motion};
+use super::spin::{Roughness, Spins};
 use super::{EventEngine, Layout, cell_width, walls_inside};
 use crate::arena::Arena;
 use crate::circle::CircleState;
+use crate::components::Rotation;
 use crate::exact::queue::EventQueue;
 use crate::grid::{CellMembers, NONE};
 use crate::segment::Segment;
@@ -33,6 +35,7 @@ pub struct EngineSnapshot {
     last_hit: Vec<f64>,
     quick_hits: Vec<u32>,
     anchor: Vec<(DVec2, f64)>,
+    spins: Option<Spins>,
 }
 
 impl EventEngine {
@@ -53,12 +56,13 @@ impl EventEngine {
             last_hit: self.last_hit.clone(),
             quick_hits: self.quick_hits.clone(),
             anchor: self.anchor.clone(),
+            spins: self.spins.clone(),
         }
     }
 
     /// The engine `snapshot` was taken of, given the same `circles` (radii and masses; their
-    /// positions and velocities are the snapshot's), arena, restitutions and gravity it was
-    /// built with. Refuses, saying why, a snapshot that does not fit them or is inconsistent in
+    /// positions, velocities and turning are the snapshot's), arena, restitutions, gravity and
+    /// roughness it was built with. Refuses, saying why, a snapshot that does not fit them or is inconsistent in
     /// itself.
     pub fn restore(
         snapshot: EngineSnapshot,
@@ -67,9 +71,11 @@ impl EventEngine {
         segments: &[Segment],
         (restitution, wall_restitution): (f64, f64),
         gravity: DVec2,
+        roughness: Roughness,
     ) -> Result<Self, String> {
         let n = circles.len();
         let s = snapshot;
+        check_turns(s.spins.as_ref(), roughness, (circles, s.now))?;
         let lengths = [
             s.motion.len(),
             s.counter.len(),
@@ -196,6 +202,7 @@ impl EventEngine {
             last_hit: s.last_hit,
             quick_hits: s.quick_hits,
             anchor: s.anchor,
+            spins: s.spins,
         };
         engine.check_pending(&stored.0, &stored.1)?;
         Ok(engine)
@@ -230,129 +237,56 @@ impl EventEngine {
     }
 }
 
+/// Whether a snapshot's turning fits the `roughness` the engine is restored with, and its
+/// `circles` at time `now`: none when smooth; when rough, one finite turn per circle, not
+/// taken after `now`, with its angle in `[-π, π]`, giving each circle its spin and rotation;
+/// no own moments of inertia, or one per circle, none NaN.
+fn check_turns(
+    spins: Option<&Spins>,
+    roughness: Roughness,
+    (circles, now): (&[CircleState], f64),
+) -> Result<(), String> {
+    let Some(spins) = spins else {
+        return match roughness.is_smooth() {
+            true => Ok(()),
+            false => Err("engine state is smooth, the effects rough".to_owned()),
+        };
+    };
+    if spins.roughness != roughness {
+        return Err("engine state's roughness differs from the effects'".to_owned());
+    }
+    if spins.turn.len() != circles.len() {
+        return Err(format!(
+            "engine state turns {} circles, expected {}",
+            spins.turn.len(),
+            circles.len()
+        ));
+    }
+    let own = &spins.own_inertia;
+    if !(own.is_empty() || own.len() == circles.len()) || own.iter().flatten().any(|i| i.is_nan()) {
+        return Err("engine state's moments of inertia do not fit the circles".to_owned());
+    }
+    let half_turn = -std::f64::consts::PI..=std::f64::consts::PI;
+    for (i, (turn, c)) in spins.turn.iter().zip(circles).enumerate() {
+        let fits = turn.spin.is_finite()
+            && half_turn.contains(&turn.angle)
+            && turn.t_at.is_finite()
+            && turn.t_at <= now
+            && turn.spin == c.angular_velocity
+            && Rotation(turn.angle).turned(turn.spin * (now - turn.t_at)).0 == c.rotation;
+        if !fits {
+            return Err(format!(
+                "engine state of circle {i} turns it otherwise than the circle"
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// How much later than the cell exit found now, relative to the time, a falling circle's
 /// stored exit may be: its roots, found from another point of the same parabola, differ by
 /// rounding, most near the parabola's top, where the root is double.
 const FALLING_EXIT_ROUNDING: f64 = 1e-6;
 
 #[cfg(test)]
-mod tests {
-    use bevy::math::DVec2;
-
-    use super::*;
-    use crate::arena::Boundary;
-
-    fn gas() -> (Vec<CircleState>, Arena) {
-        let arena = Arena::unit_square(Boundary::Periodic);
-        let circles = (0..64)
-            .map(|i| {
-                let (x, y) = ((i % 8) as f64 + 0.5, (i / 8) as f64 + 0.5);
-                let v = DVec2::new((i * 7 % 5) as f64 - 2.0, (i * 3 % 7) as f64 - 3.0);
-                CircleState::new(DVec2::new(x, y) / 8.0, v * 0.1, 0.02)
-            })
-            .collect();
-        (circles, arena)
-    }
-
-    /// The circles as the engine has them now: what a checkpoint stores beside the engine.
-    fn circles_now(engine: &EventEngine, like: &[CircleState]) -> Vec<CircleState> {
-        like.iter()
-            .enumerate()
-            .map(|(i, c)| CircleState {
-                position: engine.position(i),
-                velocity: engine.velocity(i),
-                ..*c
-            })
-            .collect()
-    }
-
-    #[test]
-    fn a_restored_engine_goes_on_bit_for_bit_as_the_original() {
-        let (circles, arena) = gas();
-        let mut original = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
-        original.advance_to(1.0, u64::MAX).unwrap();
-        let now = circles_now(&original, &circles);
-        let mut restored = EventEngine::restore(
-            original.snapshot(),
-            &now,
-            &arena,
-            &[],
-            (1.0, 1.0),
-            DVec2::ZERO,
-        )
-        .unwrap();
-        original.advance_to(5.0, u64::MAX).unwrap();
-        restored.advance_to(5.0, u64::MAX).unwrap();
-        assert!(original.stats().pair_collisions > 50);
-        assert_eq!(restored.snapshot(), original.snapshot());
-        // Rebuilding from the positions instead predicts from a different origin: the runs
-        // part by rounding, which is why checkpoints carry the engine.
-        let mut rebuilt = EventEngine::new(&now, &arena, &[], 1.0, 1.0);
-        rebuilt.advance_to(4.0, u64::MAX).unwrap();
-        let moved = |e: &EventEngine| (0..64).map(|i| e.position(i)).collect::<Vec<_>>();
-        assert_ne!(moved(&rebuilt), moved(&original));
-    }
-
-    #[test]
-    fn a_damaged_snapshot_is_refused_not_followed() {
-        let (circles, arena) = gas();
-        let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
-        engine.advance_to(0.5, u64::MAX).unwrap();
-        let now = circles_now(&engine, &circles);
-        let good = engine.snapshot();
-        let pending = (0..64)
-            .find(|&i| good.event[i].kind == Kind::Pair)
-            .expect("a pending collision");
-        let damages: [fn(&mut EngineSnapshot, usize); 12] = [
-            |s, _| s.now = f64::NAN,
-            |s, _| s.time[3] = f64::NAN,
-            |s, _| s.cell_x[5] = 1_000,
-            |s, _| s.counter.pop().map(drop).unwrap_or(()),
-            |s, _| {
-                s.event[2] = Event {
-                    kind: Kind::Pair,
-                    partner: 2,
-                    partner_count: 0,
-                }
-            },
-            |s, _| s.event[4].kind = Kind::Wall { axis: 7 },
-            |s, _| s.cell_y[9] = (s.cell_y[9] + 1) % 8,
-            // A pending collision put off for ever, flipped into the past, or before now.
-            |s, i| s.time[i] = f64::INFINITY,
-            |s, i| s.time[i] = f64::NEG_INFINITY,
-            |s, i| s.time[i] = s.now - 1e-3,
-            // A cell crossing put off, so the circle would fly on through cells it is in no
-            // list of; a pair's collision put off within the future.
-            |s, _| {
-                let k = (0..64)
-                    .find(|&k| matches!(s.event[k].kind, Kind::Cell { .. }))
-                    .expect("a pending crossing");
-                s.time[k] += 0.25;
-            },
-            |s, i| s.time[i] += 1e-9,
-        ];
-        for (k, damage) in damages.into_iter().enumerate() {
-            let mut bad = good.clone();
-            damage(&mut bad, pending);
-            assert!(
-                EventEngine::restore(bad, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_err(),
-                "damage {k} was accepted"
-            );
-        }
-        // A circle listed, consistently, in a cell two away from where it is.
-        let mut moved = good.clone();
-        let cols = engine.grid.cols;
-        assert!(cols >= 5, "{cols} columns");
-        let from = moved.cell_y[pending] as usize * cols + moved.cell_x[pending] as usize;
-        moved.cells.remove(pending, from);
-        moved.cell_x[pending] = (moved.cell_x[pending] + 2) % cols as u32;
-        moved
-            .cells
-            .insert(pending, from - from % cols + moved.cell_x[pending] as usize);
-        assert!(
-            EventEngine::restore(moved, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_err(),
-            "a circle two cells from its own was accepted"
-        );
-        assert!(EventEngine::restore(good, &now, &arena, &[], (1.0, 1.0), DVec2::ZERO).is_ok());
-    }
-}
+mod tests;

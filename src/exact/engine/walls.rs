@@ -1,5 +1,5 @@
-//! The walls the engine bounces circles off: the arena's, at an axis, and the segment walls
-//! inside it, at the point of the segment nearest the circle; and how the segment walls are
+//! The walls the engine bounces circles off (trading spin if they are rough): the arena's, at
+//! an axis, and the segment walls inside it, at the point of the segment nearest the circle; and how the segment walls are
 //! listed in the engine's cells.
 
 use super::EventEngine;
@@ -45,6 +45,7 @@ impl EventEngine {
         let centre = m.pos;
         let mut normal = bevy::math::DVec2::ZERO;
         normal[axis] = if high { 1.0 } else { -1.0 };
+        self.rough_wall(i, normal);
         self.rest_on_support(i, normal, e);
         self.sleep_if_jammed(i);
         let impulse = self.count_wall_hit(i, (new_v - v).abs());
@@ -123,6 +124,9 @@ impl EventEngine {
         }
         if put_back {
             self.relist(i);
+        }
+        if vn < 0.0 {
+            self.rough_wall(i, -out);
         }
         // Pressed against the wall by gravity with no speed, or bounced off it weakly: rest.
         self.rest_on_support(i, -out, e);

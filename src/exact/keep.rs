@@ -1,0 +1,329 @@
+//! The engine `exact` keeps between steps ([`EngineState`], also what a checkpoint stores of
+//! it) and how the continuous step gathers the circles into it: kept as it is when nothing
+//! outside touched them, updated for the few that user code moved, steered or turned, rebuilt
+//! otherwise (and every step under `swept`), rough when the effects say so.
+
+use bevy::ecs::entity::EntityHashMap;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::engine::{EngineSnapshot, EventEngine, EventStats, Rest, Roughness};
+use crate::arena::Arena;
+use crate::circle::CircleState;
+use crate::components::{
+    AngularVelocity, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep, SolverCircles,
+    SpinCircles, Velocity,
+};
+use crate::config::{Effects, Solver};
+use crate::schedule::StopRequest;
+use crate::segment::Segments;
+
+/// `exact` updates its engine in place when at most one circle in this many was moved from
+/// outside since the last step, and rebuilds it when more were (each update costs about what a
+/// collision does; a rebuild, what `N` of them do).
+const MOVED_FOR_REBUILD: usize = 4;
+
+/// The engine kept between `exact` steps, with the entities of its circles (in the order of
+/// [`SolverCircles`] when it was built) and, once a step needs it, each one's index.
+#[derive(Resource, Default)]
+pub struct EngineState {
+    pub(super) engine: Option<EventEngine>,
+    pub(super) entities: Vec<Entity>,
+    pub(super) index: EntityHashMap<usize>,
+    /// Whether the last write-back found the circles in another order than `entities` (an
+    /// entity moved between archetypes), so the next step rebuilds.
+    pub(super) reordered: bool,
+    pub(super) setup: Option<(Arena, Effects, Solver)>,
+    /// The segment walls the engine was built with.
+    pub(super) segments: Segments,
+    pub(super) last_stats: EventStats,
+    /// Steps whose event budget ran out (their remainder was free flight).
+    pub budget_exhausted: u64,
+    /// Times the engine was rebuilt from the ECS state.
+    pub rebuilds: u64,
+    /// Steps in which the kept engine was updated for a few circles moved from outside.
+    pub updates: u64,
+}
+
+impl EngineState {
+    /// The `exact` engine kept for the next step, as data for a checkpoint (`None` under the
+    /// other solvers, which keep nothing between steps).
+    pub fn snapshot(&self) -> Option<EngineSnapshot> {
+        match self.setup {
+            Some((_, _, Solver::Exact)) => self.engine.as_ref().map(EventEngine::snapshot),
+            _ => None,
+        }
+    }
+
+    /// Puts back the `exact` engine of a checkpoint for `circles` (entities in the order of the
+    /// continuous step's query, states as the engine last wrote them), so that the next step
+    /// goes on with it instead of rebuilding.
+    pub fn restore(
+        &mut self,
+        snapshot: EngineSnapshot,
+        circles: &[(Entity, CircleState)],
+        setup: (Arena, Effects, &Segments),
+    ) -> Result<(), String> {
+        let (arena, effects, segments) = setup;
+        let states: Vec<CircleState> = circles.iter().map(|&(_, c)| c).collect();
+        let mut engine = EventEngine::restore(
+            snapshot,
+            &states,
+            &arena,
+            &segments.0,
+            (effects.restitution, effects.wall_restitution),
+            effects.gravity.unwrap_or_default(),
+            roughness(&effects),
+        )?;
+        engine.record_hits(effects.hit_messages);
+        if let Some(i) = (0..engine.len()).find(|&i| engine.position(i) != states[i].position) {
+            return Err(format!(
+                "engine state of circle {i} puts it elsewhere than the circle"
+            ));
+        }
+        self.last_stats = engine.stats();
+        self.engine = Some(engine);
+        self.know(circles.iter().map(|&(e, _)| e).collect());
+        self.setup = Some((arena, effects, Solver::Exact));
+        self.segments = segments.clone();
+        Ok(())
+    }
+
+    /// Takes `entities` as the engine's circles, in index order.
+    fn know(&mut self, entities: Vec<Entity>) {
+        self.index.clear();
+        self.entities = entities;
+        self.reordered = false;
+    }
+}
+
+/// The circles anything but [`continuous_step`] wrote to since that system last ran (or that
+/// were spawned since): the only ones it looks at closely when it keeps its engine (a turned
+/// circle matters only to a rough engine).
+pub(super) type ChangedCircles<'w, 's> = Query<
+    'w,
+    's,
+    Entity,
+    (
+        With<Position>,
+        With<Velocity>,
+        With<Radius>,
+        With<Mass>,
+        Or<(
+            Changed<Position>,
+            Changed<Velocity>,
+            Changed<Radius>,
+            Changed<Mass>,
+            Changed<Restitution>,
+            Changed<AngularVelocity>,
+            Changed<Rotation>,
+            Changed<Inertia>,
+        )>,
+    ),
+>;
+
+/// The circles as the step sees them, one view at a time: all, changed, sleep, spin.
+pub(super) type EngineViews = (
+    SolverCircles<'static, 'static>,
+    ChangedCircles<'static, 'static>,
+    Query<'static, 'static, &'static mut Sleep>,
+    SpinCircles<'static, 'static>,
+);
+
+/// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
+/// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
+/// paddle); otherwise (and always for `swept`) builds a fresh one from the circles. Says which
+/// in a debug log. `restitution` says whether a circle lost its own restitution since the last
+/// step, and whether any has one. A build that `stop` ends leaves no engine: the step then
+/// moves nothing and counts in `budget_exhausted`.
+pub(super) fn gather_into_engine(
+    (setup, stop): ((Solver, Arena, Effects, &Segments), Option<&StopRequest>),
+    state: &mut EngineState,
+    restitution: (bool, bool),
+    circles: &mut ParamSet<EngineViews>,
+) {
+    let (solver, arena, effects, segments) = setup;
+    let (restitution_lost, with_own_restitution) = restitution;
+    let key = (arena, effects, solver);
+    let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
+    let reason = match (&mut state.engine, solver) {
+        (Some(_), Solver::Exact) if restitution_lost => {
+            "a circle lost its restitution or moment of inertia"
+        }
+        (Some(_), Solver::Exact) if state.reordered => "circles moved between archetypes",
+        (Some(engine), Solver::Exact)
+            if state.setup == Some(key) && state.segments == *segments =>
+        {
+            let changed: Vec<Entity> = circles.p1().iter().collect();
+            let turned = match engine.roughness().is_smooth() {
+                true => Vec::new(),
+                false => turning_of(&circles.p3(), changed.iter().copied()),
+            };
+            let all = circles.p0();
+            // Built the first time a kept engine needs it, so `swept` (which builds an engine
+            // every step) never does.
+            if !changed.is_empty() && state.index.is_empty() {
+                let entities = state.entities.iter().enumerate();
+                state.index = entities.map(|(i, &e)| (e, i)).collect();
+            }
+            let known = (state.entities.len(), &state.index);
+            let changed = (&changed[..], &turned[..]);
+            match moved_since(engine, known, changed, &all, restitution_of) {
+                Ok(moved) if moved.is_empty() => return,
+                Ok(moved) if moved.len() <= all.iter().len() / MOVED_FOR_REBUILD => {
+                    for m in &moved {
+                        if let Some((position, velocity)) = m.motion {
+                            engine.set_motion(m.index, position, velocity);
+                        }
+                        if let Some((spin, angle)) = m.turn {
+                            engine.set_turn(m.index, spin, angle);
+                        }
+                    }
+                    let n = moved.len();
+                    debug!("exact engine: updated {n} circle(s) moved from outside");
+                    state.updates += 1;
+                    return;
+                }
+                Ok(_) => "most circles were changed from outside (a force effect)",
+                Err(reason) => reason,
+            }
+        }
+        (_, Solver::Exact) => "new solver, arena, segment walls or effects",
+        _ => "swept builds every step",
+    };
+    if solver == Solver::Exact {
+        debug!("exact engine: rebuilt ({reason})");
+    }
+    let all = circles.p0();
+    let bodies: Vec<CircleState> = all
+        .iter()
+        .map(|(_, p, v, r, m, ..)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
+        .collect();
+    let rest: Vec<Rest> = all
+        .iter()
+        .map(|c| Rest {
+            asleep: c.6.asleep,
+            anchor: c.6.anchor,
+            resting_for: c.6.slow_for,
+        })
+        .collect();
+    let restitutions = (effects.restitution, effects.wall_restitution);
+    let stopped = || stop.is_some_and(StopRequest::raised);
+    let fall = (effects.gravity, &rest[..]);
+    let Some(mut engine) =
+        EventEngine::build_until(&bodies, &arena, &segments.0, restitutions, fall, stopped)
+    else {
+        // Stopped before every circle was predicted: this step moves nothing, and the next
+        // one builds again.
+        debug!("exact engine: build stopped by a stop request");
+        state.engine = None;
+        state.setup = None;
+        state.budget_exhausted += 1;
+        return;
+    };
+    if with_own_restitution {
+        engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());
+    }
+    let entities: Vec<Entity> = all.iter().map(|(e, ..)| e).collect();
+    if effects.is_rough() {
+        let turning = turning_of(&circles.p3(), entities.iter().copied());
+        engine.make_rough(roughness(&effects), turning.iter().map(|t| t.turn));
+        if turning.iter().any(|t| t.inertia.is_some()) {
+            engine.set_own_inertias(turning.iter().map(|t| t.inertia).collect());
+        }
+    }
+    engine.record_hits(effects.hit_messages);
+    state.last_stats = engine.stats();
+    state.engine = Some(engine);
+    state.know(entities);
+    state.setup = Some(key);
+    if state.segments != *segments {
+        state.segments = segments.clone();
+    }
+    state.rebuilds += 1;
+}
+
+/// What user code did to one circle of a kept engine since it last wrote it back.
+struct Moved {
+    index: usize,
+    /// Moved or steered it: its new position and velocity.
+    motion: Option<(DVec2, DVec2)>,
+    /// Turned it (in a rough engine): its new spin and angle.
+    turn: Option<(f64, f64)>,
+}
+
+/// How one circle turns, as its components say: spin and angle (0 for what it lacks), and its
+/// own moment of inertia.
+#[derive(Clone, Copy)]
+struct Turning {
+    turn: (f64, f64),
+    inertia: Option<f64>,
+}
+
+/// Of the `changed` circles (written since the kept `engine` last wrote them, or spawned), with
+/// how each turns now (in a rough engine; none in a smooth one), those user code moved,
+/// steered or turned; or why the engine cannot be kept (a circle came, went, or changed its
+/// radius, mass, restitution or moment of inertia). `known` holds how many circles the engine
+/// has and each one's index by entity.
+fn moved_since(
+    engine: &EventEngine,
+    known: (usize, &EntityHashMap<usize>),
+    (changed, turned): (&[Entity], &[Turning]),
+    circles: &SolverCircles,
+    restitution_of: impl Fn(Option<&Restitution>) -> f64,
+) -> Result<Vec<Moved>, &'static str> {
+    let (count, index) = known;
+    if circles.iter().len() != count {
+        return Err("circles were spawned or despawned");
+    }
+    let mut moved = Vec::new();
+    for (k, &entity) in changed.iter().enumerate() {
+        let (Some(&i), Ok((_, p, v, r, m, e, ..))) = (index.get(&entity), circles.get(entity))
+        else {
+            return Err("circles were spawned or despawned");
+        };
+        if engine.body(i) != (r.0, m.inverse(), restitution_of(e)) {
+            return Err("a radius, mass or restitution changed");
+        }
+        let motion = ((p.0, v.0) != (engine.position(i), engine.velocity(i))).then_some((p.0, v.0));
+        let turning = turned.get(k);
+        if turning.is_some_and(|t| t.inertia != engine.own_inertia(i)) {
+            return Err("a moment of inertia changed");
+        }
+        let turn = turning
+            .map(|t| t.turn)
+            .filter(|&t| Some(t) != engine.turn(i));
+        if motion.is_some() || turn.is_some() {
+            moved.push(Moved {
+                index: i,
+                motion,
+                turn,
+            });
+        }
+    }
+    Ok(moved)
+}
+
+/// How each of `entities` turns now.
+fn turning_of(spins: &SpinCircles, entities: impl Iterator<Item = Entity>) -> Vec<Turning> {
+    entities
+        .map(|entity| match spins.get(entity) {
+            Ok((spin, angle, _, own, _)) => Turning {
+                turn: (spin.map_or(0.0, |w| w.0), angle.map_or(0.0, |a| a.0)),
+                inertia: own.map(|i| i.0),
+            },
+            Err(_) => Turning {
+                turn: (0.0, 0.0),
+                inertia: None,
+            },
+        })
+        .collect()
+}
+
+/// The roughness of hits `effects` call for.
+pub(super) fn roughness(effects: &Effects) -> Roughness {
+    Roughness {
+        circles: effects.tangential_restitution,
+        walls: effects.wall_tangential_restitution,
+    }
+}
