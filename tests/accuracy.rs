@@ -79,7 +79,7 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
     );
     let csv = std::fs::read_to_string(out.join("accuracy.csv")).unwrap();
     for solver in ["discrete", "substeps=16", "swept", "exact"] {
-        for scene in ["gas1k", "gas", "billiards", "fast"] {
+        for scene in ["gas1k", "gas", "billiards", "fast", "rough_gas"] {
             assert!(
                 csv.lines()
                     .any(|l| l.starts_with(&format!("{scene},"))
@@ -88,9 +88,26 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
             );
         }
     }
+    // The rotation measure: where rough hits turn the circles, a solver that treats them as
+    // smooth misses all of the reference's turning, and `swept` (the same hits, events bounded
+    // per step) little of it; smooth scenes have none to compare.
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|&h| h == name).unwrap();
+    let turning_error = |scene: &str, solver: &str| -> Option<f64> {
+        let row: Vec<&str> = csv
+            .lines()
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|f| f[column("scene")] == scene && f[column("solver")] == solver)
+            .unwrap();
+        row[column("turning_error")].parse().ok()
+    };
+    assert_eq!(turning_error("rough_gas", "discrete"), Some(-1.0));
+    let swept = turning_error("rough_gas", "swept").unwrap();
+    assert!(swept.abs() < 0.05, "swept misses {swept} of the turning");
+    assert_eq!(turning_error("gas1k", "discrete"), None);
     let svg = std::fs::read_to_string(out.join("accuracy.svg")).unwrap();
     assert!(svg.starts_with("<svg"), "not an SVG");
-    for scene in ["gas1k", "gas", "billiards", "fast"] {
+    for scene in ["gas1k", "gas", "billiards", "fast", "rough_gas"] {
         for measure in &MEASURES {
             assert!(
                 svg.contains(&format!("{scene} (n = ")) && svg.contains(measure.title),

@@ -202,6 +202,7 @@ mod tests {
             z: None,
             z_error,
             speed_ks: 0.0,
+            turning_error: None,
         }
     }
 

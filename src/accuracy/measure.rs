@@ -15,6 +15,8 @@
 //! - `collision_error`: (pair collisions − reference's) / reference's;
 //! - `z` and `z_error` (pressure from the virial, relative to the reference), `speed_ks`
 //!   (Kolmogorov–Smirnov distance of the final speed distribution from the reference's);
+//! - `turning_error`: (energy of turning at the end − the reference's) / the reference's, where
+//!   the reference turns circles (rough hits): −1 for a solver that treats circles as smooth;
 //! - cost: `ms_per_step` and `ms_per_sim_second` of stepping alone.
 
 use bevy::math::DVec2;
@@ -188,6 +190,9 @@ pub struct Row {
     pub z_error: Option<f64>,
     /// KS distance of the final speed distribution from the reference's.
     pub speed_ks: f64,
+    /// Relative difference of the final energy of turning from the reference's, where the
+    /// reference has any.
+    pub turning_error: Option<f64>,
 }
 
 /// Compares `run` with `reference` (both of `case`).
@@ -235,6 +240,8 @@ pub fn compare(case: &Case, run: &Trace, reference: &Trace) -> Row {
         z: r.z,
         z_error: r.z.zip(reference.report.z).map(|(z, zr)| (z - zr) / zr),
         speed_ks: ks_distance(&run.at_end, &reference.at_end),
+        turning_error: (reference.report.rotational_final > 0.0)
+            .then(|| relative_change(reference.report.rotational_final, r.rotational_final)),
     }
 }
 

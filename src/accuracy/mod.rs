@@ -45,8 +45,8 @@ fn each_solver_and_step(solvers: &[Solver], quick: bool) -> Vec<(Solver, f64)> {
         .collect()
 }
 
-/// The study's cases (gas1k, gas, billiards, fast), from the scene files in `scenes_dir`;
-/// shorter runs when `quick`.
+/// The study's cases (gas1k, gas, billiards, fast, and the rough gas, where rotation matters),
+/// from the scene files in `scenes_dir`; shorter runs when `quick`.
 pub fn default_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputError> {
     // Billiards is compared after the break (the cue ball reaches the rack at about 0.21 s).
     let plan = [
@@ -54,6 +54,7 @@ pub fn default_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputE
         ("gas", 2.0, 0.5, HORIZON_SECONDS),
         ("billiards", 2.0, 1.0, 0.3),
         ("fast", 2.0, 0.5, HORIZON_SECONDS),
+        ("rough_gas", 5.0, 1.0, HORIZON_SECONDS),
     ];
     plan.into_iter()
         .map(|(name, seconds, quick_seconds, horizon)| {

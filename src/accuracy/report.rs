@@ -7,7 +7,7 @@ use super::measure::Row;
 /// The study as a fixed-width table.
 pub fn to_table(rows: &[Row]) -> String {
     let mut out = format!(
-        "{:<9} {:>6} {:<12} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>6} {:>9} {:>8}\n",
+        "{:<9} {:>6} {:<12} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>6} {:>9} {:>8} {:>8}\n",
         "scene",
         "n",
         "solver",
@@ -19,11 +19,12 @@ pub fn to_table(rows: &[Row]) -> String {
         "mean pen",
         "tunnel",
         "coll err",
-        "z err"
+        "z err",
+        "turn err"
     );
     for r in rows {
         out.push_str(&format!(
-            "{:<9} {:>6} {:<12} {:>6.0} {:>9.3} {:>9.2e} {:>10.1e} {:>9.2e} {:>9.2e} {:>6} {:>+9.3} {:>8}\n",
+            "{:<9} {:>6} {:<12} {:>6.0} {:>9.3} {:>9.2e} {:>10.1e} {:>9.2e} {:>9.2e} {:>6} {:>+9.3} {:>8} {:>8}\n",
             r.scene,
             r.n,
             r.solver,
@@ -36,6 +37,7 @@ pub fn to_table(rows: &[Row]) -> String {
             r.tunnelled,
             r.collision_error,
             r.z_error.map(|z| format!("{z:+.3}")).unwrap_or_else(|| "-".into()),
+            r.turning_error.map(|t| format!("{t:+.3}")).unwrap_or_else(|| "-".into()),
         ));
     }
     out
@@ -94,12 +96,13 @@ mod tests {
             z: None,
             z_error: Some(0.01),
             speed_ks: 0.0,
+            turning_error: None,
         };
         let csv = csv_text(&[row]).unwrap();
         let mut lines = csv.lines();
         let header: Vec<&str> = lines.next().unwrap().split(',').collect();
         let cells: Vec<&str> = lines.next().unwrap().split(',').collect();
-        assert_eq!(header.len(), 20);
+        assert_eq!(header.len(), 21);
         assert_eq!(header.len(), cells.len());
         let cell = |name: &str| cells[header.iter().position(|&h| h == name).unwrap()];
         assert_eq!(cell("solver"), "substeps=4");
