@@ -3,14 +3,12 @@
 //! arrays, which finds overlapping pairs with the [`broad_phase`] and resolves each with the
 //! [`contact`] kernel, and scatters the result back. On a periodic arena pairs interact across
 //! the seam through the minimum image. Pair collisions are counted here ([`PairCollisions`]),
-//! by whichever solver makes them; [`overlaps`] measures overlap in any state; [`rough`] is the
-//! tangential impulse of a rough hit, which the event engine trades spin with.
+//! by whichever solver makes them; [`overlaps`] measures overlap in any state.
 
 pub mod broad_phase;
 pub mod contact;
 pub mod overlaps;
 pub mod pass;
-pub mod rough;
 
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;

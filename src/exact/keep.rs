@@ -3,7 +3,7 @@
 //! outside touched them, updated for the few that user code moved, steered or turned, rebuilt
 //! otherwise (and every step under `swept`), rough when the effects say so.
 
-use bevy::ecs::entity::EntityHashMap;
+use bevy::ecs::entity::{EntityHashMap, EntityHashSet};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
@@ -98,8 +98,7 @@ impl EngineState {
 }
 
 /// The circles anything but [`continuous_step`] wrote to since that system last ran (or that
-/// were spawned since): the only ones it looks at closely when it keeps its engine (a turned
-/// circle matters only to a rough engine).
+/// were spawned since): the only ones it looks at closely when it keeps its engine.
 pub(super) type ChangedCircles<'w, 's> = Query<
     'w,
     's,
@@ -115,6 +114,19 @@ pub(super) type ChangedCircles<'w, 's> = Query<
             Changed<Radius>,
             Changed<Mass>,
             Changed<Restitution>,
+        )>,
+    ),
+>;
+
+/// The circles whose turning anything but [`continuous_step`] wrote to since it last ran: only
+/// a rough engine looks at them (a query of their own, so a smooth one pays nothing for it).
+pub(super) type TurnedCircles<'w, 's> = Query<
+    'w,
+    's,
+    Entity,
+    (
+        With<Radius>,
+        Or<(
             Changed<AngularVelocity>,
             Changed<Rotation>,
             Changed<Inertia>,
@@ -122,12 +134,13 @@ pub(super) type ChangedCircles<'w, 's> = Query<
     ),
 >;
 
-/// The circles as the step sees them, one view at a time: all, changed, sleep, spin.
+/// The circles as the step sees them, one view at a time: all, changed, sleep, spin, turned.
 pub(super) type EngineViews = (
     SolverCircles<'static, 'static>,
     ChangedCircles<'static, 'static>,
     Query<'static, 'static, &'static mut Sleep>,
     SpinCircles<'static, 'static>,
+    TurnedCircles<'static, 'static>,
 );
 
 /// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
@@ -154,10 +167,16 @@ pub(super) fn gather_into_engine(
         (Some(engine), Solver::Exact)
             if state.setup == Some(key) && state.segments == *segments =>
         {
-            let changed: Vec<Entity> = circles.p1().iter().collect();
+            let mut changed: Vec<Entity> = circles.p1().iter().collect();
             let turned = match engine.roughness().is_smooth() {
                 true => Vec::new(),
-                false => turning_of(&circles.p3(), changed.iter().copied()),
+                false => {
+                    // A rough engine also hears circles turned from outside.
+                    let moved: EntityHashSet = changed.iter().copied().collect();
+                    let turned = circles.p4();
+                    changed.extend(turned.iter().filter(|e| !moved.contains(e)));
+                    turning_of(&circles.p3(), changed.iter().copied())
+                }
             };
             let all = circles.p0();
             // Built the first time a kept engine needs it, so `swept` (which builds an engine

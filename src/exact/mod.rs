@@ -20,6 +20,7 @@ mod keep;
 pub mod pack;
 pub mod queue;
 pub mod roots;
+pub mod rough;
 pub mod toi;
 
 use bevy::ecs::system::SystemParam;

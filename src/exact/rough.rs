@@ -3,8 +3,8 @@
 //! contact by a tangential restitution β (Bryan's rough spheres; Huthmann and Zippelius 1997),
 //! trading energy between moving and turning. β = −1 is smooth (no tangential impulse),
 //! β = +1 perfectly rough (the slip reversed whole: with normal restitution 1 no energy lost),
-//! values between lose some. Used by the event engine at each event; the contact solver's
-//! friction is the Coulomb kind instead (`soft::friction`).
+//! values between lose some. The event engine applies it at each pair and wall event; the
+//! contact solver's friction is the Coulomb kind instead (`soft::friction`).
 
 use bevy::math::DVec2;
 
@@ -44,7 +44,7 @@ impl RoughSide {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::collide::rough::{RoughSide, apply_rough_impulse};
+/// use moving_circles::exact::rough::{RoughSide, apply_rough_impulse};
 ///
 /// // A ball sliding right along a floor below it (n points down, into the floor), unit mass
 /// // and radius, uniform disc (inverse inertia 2): a perfectly rough floor reverses the slip.
