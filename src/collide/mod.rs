@@ -113,9 +113,15 @@ fn collide_circles(
     if stats.contacts == 0 {
         return;
     }
-    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
+    // `for_each` folds over the query's tables; a `for` loop steps it one item at a time
+    // through a call the compiler may leave out of line (it did, after an unrelated change:
+    // +9 % of the 10k gas's instructions).
+    let (arena, scratch) = (*arena, &*scratch);
+    let periodic = arena.is_periodic();
+    let items = circles.iter_mut().enumerate();
+    items.for_each(|(i, (_, mut p, mut v, ..))| {
         let mut position = scratch.position(i);
-        if arena.is_periodic() && !arena.contains(position) {
+        if periodic && !arena.contains(position) {
             position = arena.wrap(position);
         }
         if p.0 != position {
@@ -125,5 +131,5 @@ fn collide_circles(
         if v.0 != velocity {
             v.0 = velocity;
         }
-    }
+    });
 }
