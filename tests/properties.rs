@@ -1,6 +1,6 @@
 //! Property tests of the numerical kernels with random inputs over many orders of magnitude:
-//! time of impact, the contact kernel (impulse + separation), wall reflection and the event
-//! engine. Each property is an invariant the code must keep for every input.
+//! time of impact, the contact kernel (impulse + separation), wall reflection, the event
+//! engine and the rough hit. Each property is an invariant the code must keep for every input.
 
 mod common;
 
@@ -8,9 +8,10 @@ use bevy::math::DVec2;
 use common::unit_box_gas;
 use moving_circles::arena::Arena;
 use moving_circles::boundary::reflect_off_walls;
-use moving_circles::circle::CircleState;
+use moving_circles::circle::{CircleState, disc_inverse_inertia};
 use moving_circles::collide::contact::resolve_contact;
 use moving_circles::exact::engine::EventEngine;
+use moving_circles::exact::rough::{RoughSide, apply_rough_impulse};
 use moving_circles::exact::toi::pair_time_of_impact;
 use proptest::prelude::*;
 
@@ -116,5 +117,84 @@ proptest! {
             }
         }
         prop_assert!((energy(&engine) - e0).abs() <= 1e-12 * e0.max(1e-300));
+    }
+}
+
+/// One side of a rough hit: a disc of random velocity, spin, radius and mass (its inverse
+/// inertia that of a uniform disc), or, one time in eight, something fixed (a wall, a static
+/// circle).
+fn rough_side() -> impl Strategy<Value = RoughSide> {
+    (vector(), wide(), positive(), positive(), any::<u8>()).prop_map(|(v, w, r, m, kind)| {
+        if kind % 8 == 0 {
+            return RoughSide {
+                radius: r,
+                ..RoughSide::fixed(DVec2::ZERO)
+            };
+        }
+        RoughSide {
+            velocity: v,
+            spin: w,
+            radius: r,
+            inv_mass: 1.0 / m,
+            inv_inertia: disc_inverse_inertia(1.0 / m, r),
+        }
+    })
+}
+
+/// Energy (moving and turning), momentum and angular momentum about the origin of the movable
+/// sides of a hit, `a` at `pa` and `b` touching it along `n`.
+fn rough_totals(pa: DVec2, n: DVec2, a: &RoughSide, b: &RoughSide) -> (f64, DVec2, f64) {
+    let pb = pa + n * (a.radius + b.radius);
+    let mut out = (0.0, DVec2::ZERO, 0.0);
+    for (p, s) in [(pa, a), (pb, b)] {
+        if s.inv_mass == 0.0 {
+            continue;
+        }
+        let (m, i) = (1.0 / s.inv_mass, 1.0 / s.inv_inertia);
+        out.0 += 0.5 * m * s.velocity.length_squared() + 0.5 * i * s.spin * s.spin;
+        out.1 += m * s.velocity;
+        out.2 += m * p.perp_dot(s.velocity) + i * s.spin;
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn a_rough_hit_never_makes_energy_and_keeps_momentum_between_movable_discs(
+        a in rough_side(),
+        b in rough_side(),
+        angle in 0.0f64..std::f64::consts::TAU,
+        beta in -1.0f64..=1.0,
+    ) {
+        let n = DVec2::from_angle(angle);
+        let (mut a2, mut b2) = (a, b);
+        let before = rough_totals(DVec2::ZERO, n, &a, &b);
+        let j = apply_rough_impulse(n, &mut a2, &mut b2, beta);
+        let after = rough_totals(DVec2::ZERO, n, &a2, &b2);
+        prop_assert!(j.is_finite());
+        prop_assert!(a2.velocity.is_finite() && b2.velocity.is_finite());
+        prop_assert!(a2.spin.is_finite() && b2.spin.is_finite());
+        // Never more energy than before (up to rounding of the largest term).
+        let scale = before.0.max(after.0);
+        prop_assert!(after.0 <= before.0 + 1e-9 * scale, "{} -> {}", before.0, after.0);
+        // Between two movable discs, momentum and angular momentum are kept (relative to the
+        // sums of their magnitudes before and after: the impulse acts at the contact point).
+        if a.inv_mass > 0.0 && b.inv_mass > 0.0 {
+            let sides = [&a, &b, &a2, &b2];
+            let m: f64 = sides.iter().map(|s| s.velocity.length() / s.inv_mass).sum();
+            let lever = a.radius + b.radius;
+            let l = m * lever + sides.iter().map(|s| s.spin.abs() / s.inv_inertia).sum::<f64>();
+            prop_assert!((after.1 - before.1).length() <= 1e-9 * m.max(f64::MIN_POSITIVE));
+            prop_assert!((after.2 - before.2).abs() <= 1e-9 * l.max(f64::MIN_POSITIVE));
+        }
+        // A fixed side neither moves nor turns.
+        for (s, s2) in [(&a, &a2), (&b, &b2)] {
+            if s.inv_mass == 0.0 {
+                prop_assert_eq!(s.velocity, s2.velocity);
+                prop_assert_eq!(s.spin, s2.spin);
+            }
+        }
     }
 }
