@@ -43,7 +43,10 @@ impl Grid {
 
     /// Cells that tile the rectangle at `origin` of this `size` exactly, as close to `min_cell`
     /// wide as fits, and never more than about four per circle on the whole (so a tiny circle in
-    /// a huge box cannot allocate millions of empty cells; wider cells stay correct).
+    /// a huge box cannot allocate millions of empty cells; wider cells stay correct). A periodic
+    /// grid keeps at least four cells a side where they fit, however few the circles: with
+    /// three, a cell's neighbour on one side is its neighbour on the other too, so a pair can
+    /// come to meet through another image without either circle crossing into a new cell.
     pub fn tiling(
         origin: DVec2,
         size: DVec2,
@@ -52,6 +55,7 @@ impl Grid {
         periodic: bool,
     ) -> Self {
         let cap = ((4 * circles).max(1) as f64).sqrt().ceil();
+        let cap = if periodic { cap.max(4.0) } else { cap };
         let count = |length: f64| {
             let fit = (length / min_cell.max(f64::MIN_POSITIVE)).floor();
             (fit.min(cap) as usize).max(1)

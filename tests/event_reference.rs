@@ -116,3 +116,34 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn two_circles_in_a_periodic_box_meet_through_the_image_they_were_not_nearest_through() {
+    // Found by the engine's property test: two circles, one moving down across the bottom
+    // edge, the other up across the top, nearest through the image above each other when
+    // predicted but meeting through the one across the edges. With only three cells a side
+    // the pair stayed neighbours all along, so nothing predicted it again and the grazing
+    // collision at t ≈ 0.70 was missed; periodic grids now keep four cells a side.
+    let seeds = [
+        (
+            0.5289168495919534,
+            0.4144455430198022,
+            0.1775489891986848,
+            -0.5636446152953456,
+            0.010687299388907912,
+            0.1,
+        ),
+        (
+            0.5630576317339624,
+            0.7292016686727365,
+            0.08302639549691045,
+            0.41290281745261,
+            0.021523465991412336,
+            0.1,
+        ),
+    ];
+    let (circles, arena) = unit_box_gas(&seeds, true);
+    let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
+    engine.advance_to(1.0, u64::MAX).unwrap();
+    assert_eq!(engine.stats().pair_collisions, 1);
+}
