@@ -7,10 +7,13 @@ mod common;
 
 use bevy::math::DVec2;
 use common::unit_box_gas;
+use moving_circles::arena::{Arena, Boundary};
 use moving_circles::circle::CircleState;
 use moving_circles::exact::engine::EventEngine;
 use moving_circles::exact::toi::{pair_time_of_impact, wall_time_of_impact};
 use proptest::prelude::*;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 /// The shortest displacement from `a` to `b` in the unit box (periodic or not).
 fn offset(a: DVec2, b: DVec2, periodic: bool) -> DVec2 {
@@ -146,4 +149,45 @@ fn two_circles_in_a_periodic_box_meet_through_the_image_they_were_not_nearest_th
     let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
     engine.advance_to(1.0, u64::MAX).unwrap();
     assert_eq!(engine.stats().pair_collisions, 1);
+}
+
+#[test]
+fn circles_wider_than_a_quarter_of_a_periodic_box_never_fly_through_each_other() {
+    // Two to four circles of radius 0.05-0.24 in a periodic unit box: the cells are as wide as
+    // a quarter of the box at most, and the widest circles' neighbourhoods wrap around it, so
+    // a pair may meet through an image it was not nearest through when predicted. Every
+    // image that can be reached before either circle is predicted again is looked at.
+    let arena = Arena::unit_square(Boundary::Periodic);
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    for trial in 0..1000 {
+        let n = rng.random_range(2..5);
+        let mut circles: Vec<CircleState> = Vec::new();
+        while circles.len() < n {
+            let p = DVec2::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+            let r = rng.random_range(0.05..0.24);
+            if circles
+                .iter()
+                .all(|c| arena.offset(c.position, p).length() > c.radius + r)
+            {
+                let v = DVec2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                circles.push(CircleState::new(p, v, r));
+            }
+        }
+        let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
+        for step in 1..=40 {
+            engine.advance_to(step as f64 * 0.05, u64::MAX).unwrap();
+            for i in 0..n {
+                for j in i + 1..n {
+                    let d = arena
+                        .offset(engine.position(i), engine.position(j))
+                        .length();
+                    let sigma = circles[i].radius + circles[j].radius;
+                    assert!(
+                        d >= sigma * (1.0 - 1e-9),
+                        "trial {trial}, step {step}: circles {i} and {j} {d} apart, radii {sigma}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -29,16 +29,28 @@ impl EventEngine {
     /// The soonest collision of circle `i` with a circle in `cells` or a large circle, not
     /// before now.
     pub(super) fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
-        if self.gravity == DVec2::ZERO {
-            self.scan_with::<false>(i, cells)
+        if self.images_wrap() && self.gravity == DVec2::ZERO {
+            self.scan_with::<false, true>(i, cells)
+        } else if self.gravity == DVec2::ZERO {
+            self.scan_with::<false, false>(i, cells)
         } else {
-            self.scan_with::<true>(i, cells)
+            self.scan_with::<true, false>(i, cells)
         }
+    }
+
+    /// Whether a pair may come to meet through another image than the one it is nearest in
+    /// without either circle crossing a cell edge first: on a periodic arena of fewer than four
+    /// cells a side (circles wider than a quarter of the box), or where a large circle's
+    /// neighbourhood wraps around the box.
+    fn images_wrap(&self) -> bool {
+        let grid = &self.grid;
+        let fewest = grid.cols.min(grid.rows) as u32;
+        grid.periodic && (fewest < 4 || self.reach.iter().any(|&reach| 2 * reach + 3 > fewest))
     }
 
     /// [`EventEngine::scan`], with the parabolas of gravity when `FALL` (a separate loop, so
     /// that the straight-line one is exactly what it is without gravity).
-    fn scan_with<const FALL: bool>(
+    fn scan_with<const FALL: bool, const IMAGES: bool>(
         &self,
         i: usize,
         cells: impl IntoIterator<Item = usize>,
@@ -49,7 +61,7 @@ impl EventEngine {
             if FALL {
                 self.look_falling(i, j, &mut best);
             } else {
-                self.look_at(&me, j, &mut best);
+                self.look_at::<IMAGES>(&me, j, &mut best);
             }
         };
         for c in cells {
@@ -103,13 +115,16 @@ impl EventEngine {
     }
 
     /// Keeps in `best` the sooner of it and the collision of the circle moving as `me` with
-    /// circle `j`, if they collide.
+    /// circle `j`, if they collide: through the image they are nearest in now, or, with
+    /// `IMAGES` ([`EventEngine::images_wrap`]), through the soonest of it and the images up to
+    /// two periods either side (each circle crosses a cell edge before it moves a cell, at
+    /// least a quarter of the box, and is predicted again then).
     ///
     /// A pair's time is worked out from the later of its two last changes of course, not from
     /// now, so it depends on the two motions alone: when the pair is looked at (after which
     /// cell crossing) cannot change it, and the cell grid does not change the trajectories.
     #[inline(always)]
-    fn look_at(&self, me: &Motion, j: usize, best: &mut BestPair) {
+    fn look_at<const IMAGES: bool>(&self, me: &Motion, j: usize, best: &mut BestPair) {
         let now = self.now;
         let other = &self.motion[j];
         // From the later reference time, where one of the two is at its reference point
@@ -125,7 +140,12 @@ impl EventEngine {
             dp.y -= whole_periods(d.y, self.period.y);
         }
         let sum = me.radius + other.radius;
-        let impact = if self.growth == 0.0 {
+        let impact = if IMAGES && self.growth == 0.0 {
+            (-2..=2)
+                .flat_map(|kx| (-2..=2).map(move |ky| DVec2::new(kx as f64, ky as f64)))
+                .filter_map(|k| pair_time_of_impact(dp + k * self.period, dv, sum))
+                .min_by(f64::total_cmp)
+        } else if self.growth == 0.0 {
             pair_time_of_impact(dp, dv, sum)
         } else {
             growing_pair_time_of_impact(
