@@ -149,6 +149,7 @@ impl EventEngine {
             segment_cells,
             large,
             reach,
+            images_wrap,
         } = walls_inside(arena, circles, segments, width);
         Self {
             arena: *arena,
@@ -193,6 +194,7 @@ impl EventEngine {
             growth: 0.0,
             large,
             reach,
+            images_wrap,
             gravity: DVec2::ZERO,
             falls: vec![false; n],
             asleep: vec![false; n],

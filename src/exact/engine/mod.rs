@@ -104,6 +104,9 @@ pub struct EventEngine {
     /// own each looks at.
     large: Vec<u32>,
     reach: Vec<u32>,
+    /// Whether a pair may meet through an image it was not nearest in when predicted, so
+    /// predictions look at every image in reach (`walls::images_wrap`).
+    images_wrap: bool,
     /// The acceleration of every falling circle (zero without gravity).
     gravity: DVec2,
     /// Whether each circle falls: movable, awake, under gravity.

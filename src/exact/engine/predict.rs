@@ -29,23 +29,13 @@ impl EventEngine {
     /// The soonest collision of circle `i` with a circle in `cells` or a large circle, not
     /// before now.
     pub(super) fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
-        if self.images_wrap() && self.gravity == DVec2::ZERO {
+        if self.images_wrap && self.gravity == DVec2::ZERO {
             self.scan_with::<false, true>(i, cells)
         } else if self.gravity == DVec2::ZERO {
             self.scan_with::<false, false>(i, cells)
         } else {
             self.scan_with::<true, false>(i, cells)
         }
-    }
-
-    /// Whether a pair may come to meet through another image than the one it is nearest in
-    /// without either circle crossing a cell edge first: on a periodic arena of fewer than four
-    /// cells a side (circles wider than a quarter of the box), or where a large circle's
-    /// neighbourhood wraps around the box.
-    fn images_wrap(&self) -> bool {
-        let grid = &self.grid;
-        let fewest = grid.cols.min(grid.rows) as u32;
-        grid.periodic && (fewest < 4 || self.reach.iter().any(|&reach| 2 * reach + 3 > fewest))
     }
 
     /// [`EventEngine::scan`], with the parabolas of gravity when `FALL` (a separate loop, so
@@ -116,7 +106,7 @@ impl EventEngine {
 
     /// Keeps in `best` the sooner of it and the collision of the circle moving as `me` with
     /// circle `j`, if they collide: through the image they are nearest in now, or, with
-    /// `IMAGES` ([`EventEngine::images_wrap`]), through the soonest of it and the images up to
+    /// `IMAGES` (`walls::images_wrap`), through the soonest of it and the images up to
     /// two periods either side (each circle crosses a cell edge before it moves a cell, at
     /// least a quarter of the box, and is predicted again then).
     ///

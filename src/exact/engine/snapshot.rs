@@ -105,6 +105,7 @@ impl EventEngine {
             segment_cells,
             large,
             reach,
+            images_wrap,
         } = walls_inside(arena, circles, segments, width);
         let partner_ok = |p: u32, i: usize| p == NONE || (p as usize) < n && p as usize != i;
         for (i, c) in circles.iter().enumerate() {
@@ -196,6 +197,7 @@ impl EventEngine {
             growth: 0.0,
             large,
             reach,
+            images_wrap,
             gravity,
             falls,
             asleep: s.asleep,

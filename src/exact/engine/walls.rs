@@ -145,6 +145,8 @@ pub(super) struct Layout {
     pub(super) segment_cells: SegmentCells,
     pub(super) large: Vec<u32>,
     pub(super) reach: Vec<u32>,
+    /// Whether predictions must look at every image in reach ([`images_wrap`]).
+    pub(super) images_wrap: bool,
 }
 
 /// The engine's [`Layout`]: cells at least `width` wide, and one diameter of every circle in
@@ -175,17 +177,28 @@ pub(super) fn walls_inside(
     // finds the walls it touches.
     let margin = largest + 1e-9 * grid.cell.max_element();
     let segment_cells = SegmentCells::build(segments, grid, margin);
-    let reach = large
+    let reach: Vec<u32> = large
         .iter()
         .map(|&i| reach(&grid, circles[i as usize].radius, in_cells))
         .collect();
+    let images_wrap = images_wrap(&grid, &reach);
     Layout {
         grid,
         segments: segments.to_vec(),
         segment_cells,
         large,
         reach,
+        images_wrap,
     }
+}
+
+/// Whether a pair may come to meet through another image than the one it is nearest in
+/// without either circle crossing a cell edge first: on a periodic `grid` of fewer than four
+/// cells a side (circles wider than a quarter of the box), or where a large circle's
+/// neighbourhood (`reach` cells) wraps around the box.
+fn images_wrap(grid: &Grid, reach: &[u32]) -> bool {
+    let fewest = grid.cols.min(grid.rows) as u32;
+    grid.periodic && (fewest < 4 || reach.iter().any(|&reach| 2 * reach + 3 > fewest))
 }
 
 /// What a cell crossing costs (moving between cell lists, one more event in the queue) and what
