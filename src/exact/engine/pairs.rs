@@ -36,10 +36,7 @@ impl EventEngine {
         if let Some(impulse) = apply_impulse(n, &mut va, &mut vb, wa, wb, bounce) {
             self.motion[i].vel = va;
             self.motion[j].vel = vb + surfaces;
-            let turning_work = match self.spins {
-                Some(_) => self.rough_pair((i, j), n, (wa, wb)),
-                None => 0.0,
-            };
+            let turning_work = self.rough_pair((i, j), n, (wa, wb));
             self.stats.pair_collisions += 1;
             self.stats.virial += (a.radius + b.radius) * impulse;
             if wa == 0.0 || wb == 0.0 {

@@ -12,7 +12,6 @@ use super::spin::{Roughness, Spins};
 use super::{EventEngine, Layout, cell_width, walls_inside};
 use crate::arena::Arena;
 use crate::circle::CircleState;
-use crate::components::Rotation;
 use crate::exact::queue::EventQueue;
 use crate::grid::{CellMembers, NONE};
 use crate::segment::Segment;
@@ -275,7 +274,7 @@ fn check_turns(
             && turn.t_at.is_finite()
             && turn.t_at <= now
             && turn.spin == c.angular_velocity
-            && Rotation(turn.angle).turned(turn.spin * (now - turn.t_at)).0 == c.rotation;
+            && turn.angle_at(now) == c.rotation;
         if !fits {
             return Err(format!(
                 "engine state of circle {i} turns it otherwise than the circle"

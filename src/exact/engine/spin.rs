@@ -45,6 +45,13 @@ pub(super) struct Turn {
     pub(super) t_at: f64,
 }
 
+impl Turn {
+    /// The angle turned to at time `t`, in `[-π, π]`.
+    pub(super) fn angle_at(&self, t: f64) -> f64 {
+        Rotation(self.angle).turned(self.spin * (t - self.t_at)).0
+    }
+}
+
 /// What a rough engine keeps: its roughness, every circle's [`Turn`], and the circles' own
 /// moments of inertia (empty when every one is a uniform disc).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -112,8 +119,7 @@ impl EventEngine {
     /// leaves turning to its caller.
     pub fn turn(&self, i: usize) -> Option<(f64, f64)> {
         let turn = self.spins.as_ref()?.turn[i];
-        let angle = Rotation(turn.angle).turned(turn.spin * (self.now - turn.t_at));
-        Some((turn.spin, angle.0))
+        Some((turn.spin, turn.angle_at(self.now)))
     }
 
     /// Sets circle `i`'s spin and angle now (something outside the engine turned it: user
@@ -196,7 +202,7 @@ impl EventEngine {
         let now = self.now;
         if let Some(spins) = &mut self.spins {
             let turn = &mut spins.turn[i];
-            turn.angle = Rotation(turn.angle).turned(turn.spin * (now - turn.t_at)).0;
+            turn.angle = turn.angle_at(now);
             turn.t_at = now;
             turn.spin = spin;
         }
