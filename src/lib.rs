@@ -160,6 +160,7 @@ pub mod boundary;
 pub mod checkpoint;
 pub mod circle;
 pub mod collide;
+pub mod collision_layers;
 #[cfg(feature = "cli")]
 pub mod commands;
 pub mod components;
@@ -185,6 +186,7 @@ pub mod run;
 pub mod scene;
 pub mod schedule;
 pub mod segment;
+pub mod sensor;
 pub mod sleep;
 pub mod soft;
 pub mod spawn;
@@ -201,6 +203,7 @@ use forces::{DragPlugin, GravityPlugin};
 use integrate::IntegratePlugin;
 use query::SpatialQueryPlugin;
 use schedule::StepPlugin;
+use sensor::SensorPlugin;
 use sleep::SleepPlugin;
 use soft::SoftPlugin;
 use spawn::SpawnPlugin;
@@ -214,6 +217,9 @@ pub mod prelude {
     pub use crate::boundary::{PeriodicPlugin, SegmentsPlugin, WallCollisions, WallsPlugin};
     pub use crate::circle::CircleState;
     pub use crate::collide::{CollidePlugin, PairCollisions};
+    pub use crate::collision_layers::{
+        CollisionLayers, OverlapEnded, OverlapStarted, Sensor, SensorOverlaps,
+    };
     pub use crate::components::{
         AngularVelocity, Friction, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep,
         Tint, Velocity,
@@ -232,6 +238,7 @@ pub mod prelude {
     pub use crate::scene::Scene;
     pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
     pub use crate::segment::{Segment, Segments};
+    pub use crate::sensor::SensorPlugin;
     pub use crate::sleep::{SleepPlugin, Sleeping};
     pub use crate::soft::SoftPlugin;
     pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
@@ -248,7 +255,8 @@ pub use schedule::CircleSystems;
 /// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
 /// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
 /// [`ContinuousPlugin`] (the `swept` and `exact` solvers), [`SoftPlugin`] (the `soft` contact
-/// solver), [`SleepPlugin`], [`DiagnosticsPlugin`], [`TransformSyncPlugin`] (each circle's
+/// solver), [`SleepPlugin`], [`SensorPlugin`] (what overlaps each
+/// [`Sensor`](collision_layers::Sensor)), [`DiagnosticsPlugin`], [`TransformSyncPlugin`] (each circle's
 /// `Transform`, if it has one, follows its [`Position`] smoothly between fixed steps) and
 /// [`SpatialQueryPlugin`] (the index behind [`SpatialQuery`](query::SpatialQuery)).
 ///
@@ -314,6 +322,7 @@ impl PluginGroup for CirclesPlugins {
             .add(ContinuousPlugin)
             .add(SoftPlugin)
             .add(SleepPlugin)
+            .add(SensorPlugin)
             .add(DiagnosticsPlugin)
             .add(TransformSyncPlugin::default())
             .add(SpatialQueryPlugin)

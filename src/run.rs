@@ -14,10 +14,11 @@ use serde::{Deserialize, Serialize};
 use crate::CirclesPlugins;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, discs, inertia, snapshot, snapshot_with_entities};
+use crate::circle::{CircleState, inertia, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::components::{Inertia, Sleep};
+use crate::collision_layers::{CollisionLayers, Sensor, solver_layers};
+use crate::components::{Inertia, Position, Radius, Sleep};
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
@@ -180,13 +181,20 @@ pub fn sample_end(
     }
 }
 
+/// The overlaps between the circles of `world` that meet.
+fn overlaps_in(world: &mut World, arena: &Arena) -> Overlaps {
+    let mut circles = world.query::<(&Position, &Radius, Option<&CollisionLayers>, Has<Sensor>)>();
+    let layered = circles
+        .iter(world)
+        .map(|(p, r, l, s)| (p.0, r.0, solver_layers(l, s)));
+    Overlaps::measure_layered(layered, arena)
+}
+
 fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl FnMut(Sample)) {
     let step = world.resource::<StepTotals>().steps;
     let circles = snapshot(world);
     let arena = *world.resource::<Arena>();
-    progress
-        .overlaps
-        .add(Overlaps::measure(&discs(&circles), &arena));
+    progress.overlaps.add(overlaps_in(world, &arena));
     observe(Sample {
         step,
         circles: &circles,
@@ -317,7 +325,7 @@ impl Report {
         let pairs = *world.resource::<PairCollisions>();
         let walls = *world.resource::<WallCollisions>();
         let arena = *world.resource::<Arena>();
-        let final_overlaps = Overlaps::measure(&discs(&snapshot(world)), &arena);
+        let final_overlaps = overlaps_in(world, &arena);
         let sleeping = world
             .query::<&Sleep>()
             .iter(world)

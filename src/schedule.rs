@@ -46,6 +46,8 @@ pub enum CircleSystems {
     /// Advancing a whole step with the contact solver, `soft` (inside [`SoftStep`]): its own
     /// substeps, gravity, drag, walls and contacts.
     Soft,
+    /// Finding what overlaps each sensor after the step (`FixedUpdate`).
+    Sensors,
     /// Measuring energy, momentum and collision rates after the step (`FixedUpdate`).
     Diagnostics,
 }
@@ -205,6 +207,7 @@ impl Plugin for StepPlugin {
                 (
                     CircleSystems::Sleep,
                     CircleSystems::Step,
+                    CircleSystems::Sensors,
                     CircleSystems::Diagnostics,
                 )
                     .chain(),

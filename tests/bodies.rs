@@ -229,7 +229,7 @@ fn circles_come_and_go_between_steps_under_every_solver() {
             let now = snapshot_with_entities(app.world_mut());
             assert_eq!(now.len(), 12, "{solver}");
             let discs: Vec<_> = now.iter().map(|(_, c)| (c.position, c.radius)).collect();
-            for (i, j, depth) in overlapping_circles(&discs, &arena) {
+            for (i, j, depth) in overlapping_circles(&discs, &arena, &[]) {
                 deepest = deepest.max(depth / discs[i].1.min(discs[j].1));
             }
         }

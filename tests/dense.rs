@@ -27,7 +27,7 @@ fn a_lattice_fills_area_fraction_0_85_with_no_overlap() {
         assert_eq!(circles.len(), wanted, "{boundary:?}: every circle placed");
         let fraction = area_fraction(&circles, &config.arena);
         assert!((fraction - 0.85).abs() < 1e-3, "{boundary:?}: {fraction}");
-        let overlaps = Overlaps::measure(&discs(&circles), &config.arena);
+        let overlaps = Overlaps::measure(&discs(&circles), &config.arena, &[]);
         assert_eq!(overlaps.pairs, 0, "{boundary:?}: {overlaps:?}");
         for c in &circles {
             let inside = match boundary {
@@ -67,7 +67,7 @@ fn the_exact_solver_melts_a_lattice_at_0_85_with_no_overlap_and_energy_kept() {
     for _ in 0..20 {
         step(&mut app, 5);
         let circles = snapshot(app.world_mut());
-        let overlaps = Overlaps::measure(&discs(&circles), &arena);
+        let overlaps = Overlaps::measure(&discs(&circles), &arena, &[]);
         assert!(overlaps.max < 1e-9, "{overlaps:?}");
     }
     let (e1, p1) = energy_momentum(&mut app);

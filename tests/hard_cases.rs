@@ -83,7 +83,7 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
     let report = run_steps(&mut app, name, steps, 1, |sample| {
         let now = sample.circles;
         let mut still = HashMap::new();
-        for (i, j, depth) in overlapping_circles(&discs(now), &arena) {
+        for (i, j, depth) in overlapping_circles(&discs(now), &arena, &[]) {
             // Touching to rounding (exactly touching circles) is contact, not an overlap to fix.
             if depth / now[i].radius.min(now[j].radius) <= ROUNDING {
                 continue;

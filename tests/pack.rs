@@ -20,7 +20,7 @@ fn pack_config(fraction: f64, radius: (f64, f64), boundary: Boundary) -> Circles
 
 /// No two circles overlap by more than rounding, and with walls every circle is inside them.
 fn assert_packed(circles: &[CircleState], arena: &Arena, what: &str) {
-    let overlaps = Overlaps::measure(&discs(circles), arena);
+    let overlaps = Overlaps::measure(&discs(circles), arena, &[]);
     assert!(overlaps.max < 1e-12, "{what}: {overlaps:?}");
     for c in circles {
         let inside = if arena.is_periodic() {

@@ -27,7 +27,7 @@ fn scene(name: &str, solver: &str) -> App {
 /// The deepest overlap among the circles now, in smaller radii.
 fn overlap(app: &mut App) -> Overlaps {
     let arena = *app.world().resource::<Arena>();
-    Overlaps::measure(&discs(&snapshot(app.world_mut())), &arena)
+    Overlaps::measure(&discs(&snapshot(app.world_mut())), &arena, &[])
 }
 
 /// The topmost circle's centre.

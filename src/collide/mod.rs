@@ -14,6 +14,7 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
+use crate::collision_layers::CircleFilters;
 use crate::components::{Restitution, SolverCircles};
 use crate::config::Effects;
 use crate::effects::{Effect, register_effect};
@@ -71,8 +72,8 @@ impl PairCollisions {
     }
 }
 
-/// Gathers the circles, resolves their contacts with [`resolve_all_contacts`] and writes back
-/// what changed; with `effects.hit_messages`, writes a [`CircleHit`] per collision.
+/// Gathers the circles (with their layers, if any circle has them), resolves their contacts
+/// with [`resolve_all_contacts`] and writes back what changed; with `effects.hit_messages`, writes a [`CircleHit`] per collision.
 #[allow(clippy::too_many_arguments)]
 fn collide_circles(
     arena: Res<Arena>,
@@ -82,19 +83,23 @@ fn collide_circles(
     mut scratch: Local<ContactScratch>,
     mut log: Local<(HitLog, Vec<Entity>)>,
     mut messages: MessageWriter<CircleHit>,
-    own_restitution: Query<(), With<Restitution>>,
+    (own_restitution, filters): (Query<(), With<Restitution>>, CircleFilters),
     mut circles: SolverCircles,
 ) {
     scratch.clear();
     let (log, entities) = &mut *log;
     entities.clear();
     let per_circle = !own_restitution.is_empty();
+    let filtered = filters.any();
     for (e, p, v, r, m, own, sleep) in &circles {
         // A sleeping circle is an immovable circle at rest until it is woken.
         let mass = if sleep.asleep { f64::INFINITY } else { m.0 };
         scratch.push(p.0, v.0, r.0, mass);
         if per_circle {
             scratch.push_restitution(own.map_or(effects.restitution, |own| own.0));
+        }
+        if filtered {
+            scratch.push_layers(filters.of(e));
         }
         if effects.hit_messages {
             entities.push(e);

@@ -12,6 +12,7 @@ use super::contact::{combine_restitution, resolve_contact, work_by_immovable};
 use crate::arena::Arena;
 use crate::boundary::put_back_inside;
 use crate::circle::CircleState;
+use crate::collision_layers::{CollisionLayers, pair_meets};
 use crate::hits::{CircleHit, HitLog};
 
 /// The circles of one collision pass, and buffers reused from pass to pass so the hot path
@@ -24,6 +25,8 @@ pub struct ContactScratch {
     masses: Vec<f64>,
     /// Each circle's own restitution, or empty when every circle takes the pass's.
     restitutions: Vec<f64>,
+    /// Each circle's layers, or empty when every pair meets.
+    layers: Vec<CollisionLayers>,
     /// `discs` in cell order, while contacts are resolved.
     sorted: Vec<(DVec2, f64)>,
     /// `0, 1, 2, …`: the order of the multi-level path, which resolves in input order.
@@ -39,6 +42,7 @@ impl ContactScratch {
         self.velocities.clear();
         self.masses.clear();
         self.restitutions.clear();
+        self.layers.clear();
     }
 
     /// Adds a circle to the next [`resolve_all_contacts`].
@@ -54,6 +58,13 @@ impl ContactScratch {
     #[inline]
     pub fn push_restitution(&mut self, restitution: f64) {
         self.restitutions.push(restitution);
+    }
+
+    /// Gives the circle pushed last its layers. Either every circle gets them (pushed right
+    /// after it) or none does (every pair meets); a pair that does not meet is left alone.
+    #[inline]
+    pub fn push_layers(&mut self, layers: CollisionLayers) {
+        self.layers.push(layers);
     }
 
     /// Centre of circle `i` now.
@@ -83,7 +94,8 @@ pub struct PassStats {
 }
 
 /// Finds and resolves all overlapping pairs among the circles in `scratch`, in the broad
-/// phase's scan order, with `restitution` (or the circles' own, if they have theirs). Each
+/// phase's scan order, with `restitution` (or the circles' own, if they have theirs), leaving
+/// out pairs whose layers do not meet. Each
 /// collision is recorded in `hits` if given (circle indices in push order, time 0).
 ///
 /// Circles of similar size are found in cell order ([`pairs_in_cell_order`]) and their centres
@@ -100,6 +112,7 @@ pub fn resolve_all_contacts(
         velocities,
         masses,
         restitutions,
+        layers,
         sorted,
         identity,
         pairs,
@@ -117,6 +130,15 @@ pub fn resolve_all_contacts(
         pairs_in_cell_order(cells, arena, discs, radii.1, sorted, pairs);
         cells.order()
     };
+    if !layers.is_empty() {
+        pairs.retain(|&(k, l)| {
+            pair_meets(
+                layers,
+                order[k as usize] as usize,
+                order[l as usize] as usize,
+            )
+        });
+    }
     let mut stats = PassStats::default();
     let circle = |(position, radius): (DVec2, f64), velocity, mass| {
         CircleState::new(position, velocity, radius).with_mass(mass)

@@ -10,6 +10,7 @@ use bevy::prelude::*;
 use super::engine::{EngineSnapshot, EventEngine, EventStats, Rest, Roughness};
 use crate::arena::Arena;
 use crate::circle::CircleState;
+use crate::collision_layers::{CircleFilters, CollisionLayers, Sensor};
 use crate::components::{
     AngularVelocity, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep, SolverCircles,
     SpinCircles, Velocity,
@@ -114,6 +115,8 @@ pub(super) type ChangedCircles<'w, 's> = Query<
             Changed<Radius>,
             Changed<Mass>,
             Changed<Restitution>,
+            Changed<CollisionLayers>,
+            Changed<Sensor>,
         )>,
     ),
 >;
@@ -143,25 +146,34 @@ pub(super) type EngineViews = (
     TurnedCircles<'static, 'static>,
 );
 
+/// What circles have of their own beyond their motion, as the continuous step gathers it.
+pub(super) struct Own<'a> {
+    /// Whether a circle lost its own restitution, moment of inertia, layers or sensor since
+    /// the last step (a kept engine cannot tell).
+    pub lost: bool,
+    /// Whether any circle has its own restitution.
+    pub restitution: bool,
+    /// Each circle's layers.
+    pub filters: &'a CircleFilters<'a, 'a>,
+}
+
 /// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
 /// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
-/// paddle); otherwise (and always for `swept`) builds a fresh one from the circles. Says which
-/// in a debug log. `restitution` says whether a circle lost its own restitution since the last
-/// step, and whether any has one. A build that `stop` ends leaves no engine: the step then
-/// moves nothing and counts in `budget_exhausted`.
+/// paddle); otherwise (and always for `swept`) builds a fresh one from the circles, with their
+/// own restitutions and layers. Says which in a debug log. A build that `stop` ends leaves no
+/// engine: the step then moves nothing and counts in `budget_exhausted`.
 pub(super) fn gather_into_engine(
     (setup, stop): ((Solver, Arena, Effects, &Segments), Option<&StopRequest>),
     state: &mut EngineState,
-    restitution: (bool, bool),
+    own: Own,
     circles: &mut ParamSet<EngineViews>,
 ) {
     let (solver, arena, effects, segments) = setup;
-    let (restitution_lost, with_own_restitution) = restitution;
     let key = (arena, effects, solver);
     let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
     let reason = match (&mut state.engine, solver) {
-        (Some(_), Solver::Exact) if restitution_lost => {
-            "a circle lost its restitution or moment of inertia"
+        (Some(_), Solver::Exact) if own.lost => {
+            "a circle lost its restitution, moment of inertia, layers or sensor"
         }
         (Some(_), Solver::Exact) if state.reordered => "circles moved between archetypes",
         (Some(engine), Solver::Exact)
@@ -187,7 +199,8 @@ pub(super) fn gather_into_engine(
             }
             let known = (state.entities.len(), &state.index);
             let changed = (&changed[..], &turned[..]);
-            match moved_since(engine, known, changed, &all, restitution_of) {
+            let body_of = (restitution_of, own.filters);
+            match moved_since(engine, known, changed, &all, body_of) {
                 Ok(moved) if moved.is_empty() => return,
                 Ok(moved) if moved.len() <= all.iter().len() / MOVED_FOR_REBUILD => {
                     for m in &moved {
@@ -226,12 +239,20 @@ pub(super) fn gather_into_engine(
             resting_for: c.6.slow_for,
         })
         .collect();
+    let entities: Vec<Entity> = all.iter().map(|(e, ..)| e).collect();
+    let layers = own.filters.gather(entities.iter().copied());
     let restitutions = (effects.restitution, effects.wall_restitution);
     let stopped = || stop.is_some_and(StopRequest::raised);
     let fall = (effects.gravity, &rest[..]);
-    let Some(mut engine) =
-        EventEngine::build_until(&bodies, &arena, &segments.0, restitutions, fall, stopped)
-    else {
+    let Some(mut engine) = EventEngine::build_until(
+        &bodies,
+        &arena,
+        &segments.0,
+        restitutions,
+        fall,
+        layers,
+        stopped,
+    ) else {
         // Stopped before every circle was predicted: this step moves nothing, and the next
         // one builds again.
         debug!("exact engine: build stopped by a stop request");
@@ -240,10 +261,9 @@ pub(super) fn gather_into_engine(
         state.budget_exhausted += 1;
         return;
     };
-    if with_own_restitution {
+    if own.restitution {
         engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());
     }
-    let entities: Vec<Entity> = all.iter().map(|(e, ..)| e).collect();
     if effects.is_rough() {
         let turning = turning_of(&circles.p3(), entities.iter().copied());
         engine.make_rough(roughness(&effects), turning.iter().map(|t| t.turn));
@@ -282,14 +302,14 @@ struct Turning {
 /// Of the `changed` circles (written since the kept `engine` last wrote them, or spawned), with
 /// how each turns now (in a rough engine; none in a smooth one), those user code moved,
 /// steered or turned; or why the engine cannot be kept (a circle came, went, or changed its
-/// radius, mass, restitution or moment of inertia). `known` holds how many circles the engine
-/// has and each one's index by entity.
+/// radius, mass, restitution, layers or moment of inertia). `known` holds how many circles the
+/// engine has and each one's index by entity.
 fn moved_since(
     engine: &EventEngine,
     known: (usize, &EntityHashMap<usize>),
     (changed, turned): (&[Entity], &[Turning]),
     circles: &SolverCircles,
-    restitution_of: impl Fn(Option<&Restitution>) -> f64,
+    (restitution_of, filters): (impl Fn(Option<&Restitution>) -> f64, &CircleFilters),
 ) -> Result<Vec<Moved>, &'static str> {
     let (count, index) = known;
     if circles.iter().len() != count {
@@ -303,6 +323,9 @@ fn moved_since(
         };
         if engine.body(i) != (r.0, m.inverse(), restitution_of(e)) {
             return Err("a radius, mass or restitution changed");
+        }
+        if filters.of(entity) != engine.layers(i) {
+            return Err("a circle's layers changed or it became a sensor");
         }
         let motion = ((p.0, v.0) != (engine.position(i), engine.velocity(i))).then_some((p.0, v.0));
         let turning = turned.get(k);

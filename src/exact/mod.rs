@@ -29,6 +29,7 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
+use crate::collision_layers::{CircleFilters, CollisionLayers, Sensor};
 use crate::components::{Inertia, Restitution, Sleep, SolverCircles, SpinCircles};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
@@ -36,7 +37,7 @@ use crate::integrate::turn_circles;
 use crate::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
 use crate::segment::Segments;
 use crate::sleep::Sleeping;
-use keep::{EngineViews, gather_into_engine};
+use keep::{EngineViews, Own, gather_into_engine};
 
 pub use keep::EngineState;
 
@@ -83,13 +84,38 @@ struct StepSetup<'w> {
     stop: Option<Res<'w, StopRequest>>,
 }
 
+/// The components a circle may lose that a kept engine cannot tell it lost.
+#[derive(SystemParam)]
+struct Lost<'w, 's> {
+    restitution: RemovedComponents<'w, 's, Restitution>,
+    inertia: RemovedComponents<'w, 's, Inertia>,
+    layers: RemovedComponents<'w, 's, CollisionLayers>,
+    sensor: RemovedComponents<'w, 's, Sensor>,
+}
+
+impl Lost<'_, '_> {
+    /// Whether any circle lost its own restitution, moment of inertia, layers or sensor since
+    /// the last look (and forgets it).
+    fn any(&mut self) -> bool {
+        let lost = !self.restitution.is_empty()
+            || !self.inertia.is_empty()
+            || !self.layers.is_empty()
+            || !self.sensor.is_empty();
+        self.restitution.clear();
+        self.inertia.clear();
+        self.layers.clear();
+        self.sensor.clear();
+        lost
+    }
+}
+
 /// The `swept` / `exact` step: gathers the circles into the engine, advances it by the step and
 /// writes the circles back (see the module docs for why this is one system).
 fn continuous_step(
     setup: StepSetup,
     mut state: ResMut<EngineState>,
-    own_restitution: Query<(), With<Restitution>>,
-    mut lost: (RemovedComponents<Restitution>, RemovedComponents<Inertia>),
+    own: (Query<(), With<Restitution>>, CircleFilters),
+    mut lost: Lost,
     mut circles: ParamSet<EngineViews>,
     mut counted: Counted,
     messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
@@ -102,15 +128,16 @@ fn continuous_step(
         dt,
         stop,
     } = setup;
-    // A circle that lost its own restitution or moment of inertia: the engine cannot tell.
-    let restitution_lost = !lost.0.is_empty() || !lost.1.is_empty();
-    lost.0.clear();
-    lost.1.clear();
-    let with_own_restitution = !own_restitution.is_empty();
+    let (own_restitution, filters) = own;
+    let own = Own {
+        lost: lost.any(),
+        restitution: !own_restitution.is_empty(),
+        filters: &filters,
+    };
     gather_into_engine(
         ((*solver, *arena, *effects, &segments), stop.as_deref()),
         &mut state,
-        (restitution_lost, with_own_restitution),
+        own,
         &mut circles,
     );
     advance_engine(

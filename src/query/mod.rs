@@ -41,6 +41,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
+use crate::collision_layers::{CollisionLayers, Sensor};
 use crate::components::{Position, Radius};
 use crate::hits::{ArenaWall, Wall};
 use crate::segment::{Segment, Segments};
@@ -92,6 +93,11 @@ pub struct QueryFilter {
     pub walls: bool,
     /// Circles left out (the caster itself, say).
     pub excluded: EntityHashSet,
+    /// The groups a circle must be in (one of them) to count, as
+    /// [`CollisionLayers::memberships`] (a circle without layers is in group 0).
+    pub mask: u32,
+    /// Whether [`Sensor`] circles count.
+    pub sensors: bool,
 }
 
 impl Default for QueryFilter {
@@ -100,6 +106,8 @@ impl Default for QueryFilter {
             circles: true,
             walls: true,
             excluded: EntityHashSet::default(),
+            mask: u32::MAX,
+            sensors: true,
         }
     }
 }
@@ -127,8 +135,24 @@ impl QueryFilter {
         self
     }
 
-    fn takes(&self, entity: Entity) -> bool {
-        self.circles && !self.excluded.contains(&entity)
+    /// This filter, counting only circles in one of the groups of `mask`.
+    pub fn with_mask(self, mask: u32) -> Self {
+        Self { mask, ..self }
+    }
+
+    /// This filter, leaving sensors out (a ray that should see only what pushes back).
+    pub fn excluding_sensors(self) -> Self {
+        Self {
+            sensors: false,
+            ..self
+        }
+    }
+
+    fn takes(&self, entity: Entity, (memberships, sensor): (u32, bool)) -> bool {
+        self.circles
+            && memberships & self.mask != 0
+            && (self.sensors || !sensor)
+            && !self.excluded.contains(&entity)
     }
 }
 
@@ -143,10 +167,20 @@ pub struct SpatialIndex {
 struct Built {
     circles: CircleIndex,
     entities: Vec<Entity>,
+    /// Each circle's memberships and whether it is a sensor.
+    kinds: Vec<(u32, bool)>,
     /// The arena the index was built for.
     arena: Arena,
     /// Centres and radii while building, reused.
     scratch: Vec<(DVec2, f64)>,
+}
+
+impl Built {
+    /// Whether `filter` takes circle `i` of the index.
+    fn takes(&self, filter: &QueryFilter, i: u32) -> bool {
+        let i = i as usize;
+        filter.takes(self.entities[i], self.kinds[i])
+    }
 }
 
 impl Default for SpatialIndex {
@@ -165,13 +199,22 @@ impl SpatialIndex {
     }
 }
 
+/// What the index holds of each circle.
+type Indexed = (
+    Entity,
+    &'static Position,
+    &'static Radius,
+    Option<&'static CollisionLayers>,
+    Has<Sensor>,
+);
+
 /// Spatial queries against the circles, the arena's walls and the segment walls, as a system
 /// parameter (see the [module](self) for when the index sees a change). Directions need not be
 /// unit length; a zero or non-finite direction, a negative or NaN radius or distance, or a
 /// non-finite point finds nothing.
 #[derive(SystemParam)]
 pub struct SpatialQuery<'w, 's> {
-    circles: Query<'w, 's, (Entity, &'static Position, &'static Radius)>,
+    circles: Query<'w, 's, Indexed>,
     index: Res<'w, SpatialIndex>,
     arena: Res<'w, Arena>,
     segments: Res<'w, Segments>,
@@ -241,7 +284,7 @@ impl SpatialQuery<'_, '_> {
         }
         let circle = filter.circles.then(|| {
             self.with_index(|built| {
-                let takes = |i: u32| filter.takes(built.entities[i as usize]);
+                let takes = |i: u32| built.takes(filter, i);
                 let hit = built.circles.cast(centre, d, radius, max_distance, takes)?;
                 Some((
                     hit.distance,
@@ -293,7 +336,7 @@ impl SpatialQuery<'_, '_> {
         self.with_index(|built| {
             let mut found = Vec::new();
             built.circles.for_each_near(p, reach, |i, offset, r| {
-                if hits(offset, r) && filter.takes(built.entities[i as usize]) {
+                if hits(offset, r) && built.takes(filter, i) {
                     found.push(i);
                 }
             });
@@ -346,13 +389,16 @@ impl SpatialQuery<'_, '_> {
                 let Built {
                     circles,
                     entities,
+                    kinds,
                     arena,
                     scratch,
                 } = &mut *built;
                 entities.clear();
+                kinds.clear();
                 scratch.clear();
-                for (entity, position, radius) in &self.circles {
+                for (entity, position, radius, layers, sensor) in &self.circles {
                     entities.push(entity);
+                    kinds.push((layers.copied().unwrap_or_default().memberships, sensor));
                     scratch.push((position.0, radius.0));
                 }
                 *arena = *self.arena;

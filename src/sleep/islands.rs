@@ -7,6 +7,7 @@ use bevy::math::DVec2;
 
 use crate::arena::Arena;
 use crate::collide::broad_phase::{CellList, overlapping_pairs};
+use crate::collision_layers::{CollisionLayers, pair_meets};
 use crate::components::Sleep;
 
 /// Gap (in the smaller radius) within which two circles count as touching for an island.
@@ -75,6 +76,9 @@ impl Resting {
 /// phase's cells and the pairs it found.
 #[derive(Default)]
 pub struct IslandScratch {
+    /// Each circle's layers (filled by the caller), or empty when every pair meets: circles
+    /// that do not meet do not touch.
+    pub layers: Vec<CollisionLayers>,
     chosen: Vec<u32>,
     reach: Vec<(DVec2, f64)>,
     cells: CellList,
@@ -82,7 +86,7 @@ pub struct IslandScratch {
 }
 
 impl IslandScratch {
-    /// The touching pairs among the circles `chosen` selects, as positions in
+    /// The touching pairs that meet among the circles `chosen` selects, as positions in
     /// `self.chosen`.
     fn touching_pairs(
         &mut self,
@@ -100,6 +104,16 @@ impl IslandScratch {
         }));
         self.pairs.clear();
         overlapping_pairs(&mut self.cells, arena, &self.reach, &mut self.pairs);
+        if !self.layers.is_empty() {
+            let (chosen, layers) = (&self.chosen, &self.layers);
+            self.pairs.retain(|&(k, l)| {
+                pair_meets(
+                    layers,
+                    chosen[k as usize] as usize,
+                    chosen[l as usize] as usize,
+                )
+            });
+        }
     }
 }
 

@@ -18,6 +18,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::arena::Arena;
+use crate::collision_layers::CircleFilters;
 use crate::components::{AngularVelocity, Mass, Position, Radius, Sleep, Velocity};
 use crate::config::{Effects, SleepConfig, Solver};
 use crate::effects::{Effect, register_effect};
@@ -117,6 +118,7 @@ type SleepingCircles<'w, 's> = Query<
     'w,
     's,
     (
+        Entity,
         Ref<'static, Position>,
         Mut<'static, Velocity>,
         Ref<'static, Radius>,
@@ -137,7 +139,7 @@ fn update_sleep(
     totals: Res<StepTotals>,
     mut sleeping: ResMut<Sleeping>,
     mut scratch: Local<SleepScratch>,
-    mut circles: SleepingCircles,
+    (mut circles, filters): (SleepingCircles, CircleFilters),
 ) {
     let (effects, arena, solver, time) = settings;
     if solver.is_continuous() {
@@ -147,8 +149,13 @@ fn update_sleep(
     let dt = time.timestep().as_secs_f64();
     let (resting, islands) = &mut *scratch;
     resting.clear();
+    islands.layers.clear();
+    let filtered = filters.any();
     let (mut stirring, mut asleep, mut ready) = (false, 0usize, false);
-    for (position, velocity, radius, mass, mut sleep, spin) in &mut circles {
+    for (entity, position, velocity, radius, mass, mut sleep, spin) in &mut circles {
+        if filtered {
+            islands.layers.push(filters.of(entity));
+        }
         let movable = !mass.is_immovable();
         let moved = |changed: bool, added: bool| changed && !added;
         let spun = spin
@@ -193,7 +200,7 @@ fn update_sleep(
         changed |= !fall_asleep(resting, &arena, config.time, islands).is_empty();
     }
     if changed {
-        for (i, (_, mut velocity, _, _, mut sleep, spin)) in circles.iter_mut().enumerate() {
+        for (i, (_, _, mut velocity, _, _, mut sleep, spin)) in circles.iter_mut().enumerate() {
             if *sleep != resting[i].sleep {
                 *sleep = resting[i].sleep;
                 if sleep.asleep && velocity.0 != DVec2::ZERO {

@@ -6,6 +6,7 @@ use std::f64::consts::TAU;
 use bevy::math::DVec2;
 
 use crate::circle::inverse_inertia;
+use crate::collision_layers::CollisionLayers;
 
 /// The circles of one `soft` step, as plain arrays in one order (the solver's query's).
 #[derive(Clone, Debug, Default)]
@@ -31,6 +32,8 @@ pub struct Bodies {
     /// Each circle's own friction coefficient (NaN for one without), or empty when every
     /// circle takes the scene's.
     pub friction: Vec<f64>,
+    /// Each circle's layers, or empty when every pair meets.
+    pub layers: Vec<CollisionLayers>,
     /// A stable identity per circle (its entity), so a contact is recognised next step.
     pub id: Vec<u64>,
 }
@@ -47,6 +50,7 @@ impl Bodies {
         self.inv_inertia.clear();
         self.restitution.clear();
         self.friction.clear();
+        self.layers.clear();
         self.id.clear();
     }
 

@@ -9,6 +9,7 @@ use super::bodies::{Bodies, Softness};
 use crate::arena::Arena;
 use crate::collide::broad_phase::{CellList, overlapping_pairs};
 use crate::collide::contact::{combine_restitution, contact_normal};
+use crate::collision_layers::{meets_any, pair_meets};
 use crate::config::Combine;
 use crate::exact::toi::pair_time_of_impact;
 use crate::grid::NONE;
@@ -204,6 +205,8 @@ pub fn turning_rows<'a>(
 /// Reusable buffers of contact finding.
 #[derive(Default)]
 pub struct ContactScratch {
+    /// The circles the broad phase searches, by index.
+    searched: Vec<u32>,
     reach: Vec<(DVec2, f64)>,
     candidates: Vec<(u32, u32)>,
     cells: CellList,
@@ -232,8 +235,16 @@ pub fn find_contacts(
     let fall = rules.gravity.length() * dt * dt;
     let travel = |i: usize| bodies.velocity[i].length() * dt + fall;
     if rules.collisions {
+        // Circles that meet nothing (sensors) stay out of the search, so they change neither
+        // its cells nor the order of the contacts.
+        scratch.searched.clear();
+        let layers = &bodies.layers;
+        let searched = (0..bodies.len() as u32)
+            .filter(|&i| layers.is_empty() || meets_any(layers[i as usize]));
+        scratch.searched.extend(searched);
         scratch.reach.clear();
-        scratch.reach.extend((0..bodies.len()).map(|i| {
+        scratch.reach.extend(scratch.searched.iter().map(|&i| {
+            let i = i as usize;
             let r = bodies.radius[i];
             (
                 bodies.position[i],
@@ -243,7 +254,11 @@ pub fn find_contacts(
         scratch.candidates.clear();
         let (reach, candidates) = (&scratch.reach, &mut scratch.candidates);
         overlapping_pairs(&mut scratch.cells, arena, reach, candidates);
-        for &(i, j) in candidates.iter() {
+        for &(k, l) in candidates.iter() {
+            let (i, j) = (scratch.searched[k as usize], scratch.searched[l as usize]);
+            if !pair_meets(layers, i as usize, j as usize) {
+                continue;
+            }
             if let Some(c) = pair_contact(bodies, arena, rules, (i as usize, j as usize)) {
                 pairs.push(c);
             }

@@ -25,6 +25,7 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
+use crate::collision_layers::CircleFilters;
 use crate::components::{Friction, Restitution, SolverCircles, SpinCircles};
 use crate::config::{Effects, SoftConfig, Solver};
 use crate::hits::{CircleHit, HitLog, WallHit};
@@ -110,13 +111,19 @@ struct SoftSetup<'w> {
     dt: Res<'w, StepDt>,
 }
 
+/// Whether any circle has its own restitution, and any its own friction.
+type Own<'w, 's> = (
+    Query<'w, 's, (), With<Restitution>>,
+    Query<'w, 's, (), With<Friction>>,
+);
+
 /// Gathers the circles into [`Bodies`], advances them one step with [`soft_step`], writes back
 /// what changed, counts collisions and wall hits and, with `effects.hit_messages`, writes
 /// their messages.
 fn step_soft(
     setup: SoftSetup,
     mut state: ResMut<SoftState>,
-    own: (Query<(), With<Restitution>>, Query<(), With<Friction>>),
+    (own, filters): (Own, CircleFilters),
     counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
     (mut circles, mut spins): (SolverCircles, SpinCircles),
@@ -153,6 +160,7 @@ fn step_soft(
         }
         entities.push(entity);
     }
+    bodies.layers = filters.gather(entities.iter().copied());
     // Spin only where something may turn: friction, or a circle turning already.
     let spinning = effects.has_friction()
         || per_circle.1

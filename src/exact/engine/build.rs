@@ -9,6 +9,7 @@ use super::events::{Event, EventStats, Kind, Motion, NO_PAIR, Rest};
 use super::walls::{Layout, cell_width, walls_inside};
 use crate::arena::Arena;
 use crate::circle::CircleState;
+use crate::collision_layers::CollisionLayers;
 use crate::exact::queue::EventQueue;
 use crate::grid::{CellMembers, NONE};
 use crate::segment::Segment;
@@ -57,7 +58,8 @@ impl EventEngine {
         engine
     }
 
-    /// [`EventEngine::new`], or [`EventEngine::falling`] under `gravity`, asking `stop` every
+    /// [`EventEngine::new`], or [`EventEngine::falling`] under `gravity`, with each circle's
+    /// `layers` (empty: every pair meets, [`EventEngine::set_layers`]), asking `stop` every
     /// [`STOP_POLL_CIRCLES`] predictions whether to give up: `None` when it did. A build of
     /// millions of circles takes seconds, which a signal must not wait for.
     pub fn build_until(
@@ -66,8 +68,10 @@ impl EventEngine {
         segments: &[Segment],
         restitutions: (f64, f64),
         (gravity, rest): (Option<DVec2>, &[Rest]),
+        layers: Vec<CollisionLayers>,
         stop: impl Fn() -> bool,
     ) -> Option<Self> {
+        assert!(layers.is_empty() || layers.len() == circles.len());
         let mut engine = match gravity {
             Some(g) => Self::placed_falling(circles, arena, segments, restitutions, g, rest),
             None => Self::placed(
@@ -78,6 +82,7 @@ impl EventEngine {
                 cell_width(arena, circles),
             ),
         };
+        engine.layers = layers;
         engine.predict_all_until(stop).then_some(engine)
     }
 
@@ -190,6 +195,7 @@ impl EventEngine {
             segments,
             segment_cells,
             own_restitution: Vec::new(),
+            layers: Vec::new(),
             hits: None,
             growth: 0.0,
             large,
@@ -231,10 +237,19 @@ mod tests {
             asked.get() == 2
         };
         assert!(
-            EventEngine::build_until(&circles, &arena, &[], restitutions, fall, stop).is_none()
+            EventEngine::build_until(&circles, &arena, &[], restitutions, fall, Vec::new(), stop)
+                .is_none()
         );
         assert_eq!(asked.get(), 2);
-        let whole = EventEngine::build_until(&circles, &arena, &[], restitutions, fall, || false);
+        let whole = EventEngine::build_until(
+            &circles,
+            &arena,
+            &[],
+            restitutions,
+            fall,
+            Vec::new(),
+            || false,
+        );
         let new = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         assert_eq!(whole.map(|e| e.snapshot()), Some(new.snapshot()));
     }

@@ -44,6 +44,7 @@ use bevy::math::DVec2;
 
 use super::queue::EventQueue;
 use crate::arena::Arena;
+use crate::collision_layers::{CollisionLayers, pair_meets};
 use crate::grid::{CellMembers, Grid};
 use crate::hits::HitLog;
 use crate::segment::{Segment, SegmentCells};
@@ -95,6 +96,9 @@ pub struct EventEngine {
     segment_cells: SegmentCells,
     /// Each circle's own restitution, or empty when all take the engine's.
     own_restitution: Vec<f64>,
+    /// Each circle's layers, or empty when every pair meets: a pair that does not meet is
+    /// never predicted.
+    layers: Vec<CollisionLayers>,
     /// Hits since the last [`EventEngine::drain_hits`], when recording.
     hits: Option<HitLog>,
     /// How fast radii grow: circle `i`'s radius is `radius·(1 + growth·t)`. 0 but in a
@@ -129,6 +133,26 @@ impl EventEngine {
     pub fn set_own_restitutions(&mut self, restitutions: Vec<f64>) {
         assert!(restitutions.is_empty() || restitutions.len() == self.len());
         self.own_restitution = restitutions;
+    }
+
+    /// Gives each circle its layers (one per circle, in order; empty: every pair meets) and
+    /// predicts every circle again, so no pair that does not meet has an event. To build an
+    /// engine with layers from the start, see [`EventEngine::build_until`].
+    pub fn set_layers(&mut self, layers: Vec<CollisionLayers>) {
+        assert!(layers.is_empty() || layers.len() == self.len());
+        self.layers = layers;
+        self.predict_all();
+    }
+
+    /// Circle `i`'s layers ([`CollisionLayers::DEFAULT`] when the engine has none).
+    pub fn layers(&self, i: usize) -> CollisionLayers {
+        self.layers.get(i).copied().unwrap_or_default()
+    }
+
+    /// Whether circles `i` and `j` meet.
+    #[inline]
+    pub(super) fn meets(&self, i: usize, j: usize) -> bool {
+        pair_meets(&self.layers, i, j)
     }
 
     /// Starts (or stops) recording every collision and wall hit, with its exact time, for

@@ -26,8 +26,8 @@ use crate::exact::toi::{
 use crate::grid::NONE;
 
 impl EventEngine {
-    /// The soonest collision of circle `i` with a circle in `cells` or a large circle, not
-    /// before now.
+    /// The soonest collision of circle `i` with a circle in `cells` or a large circle that it
+    /// meets, not before now.
     pub(super) fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
         if self.images_wrap && self.gravity == DVec2::ZERO {
             self.scan_with::<false, true>(i, cells)
@@ -47,7 +47,15 @@ impl EventEngine {
     ) -> BestPair {
         let me = self.motion[i];
         let mut best = NO_PAIR;
+        // With layers, a pair that does not meet has no event (a branch the same way for every
+        // neighbour without them).
+        let mine = self.layers.get(i).copied();
         let mut look = |j: usize| {
+            if let Some(mine) = mine
+                && !mine.meets(self.layers[j])
+            {
+                return;
+            }
             if FALL {
                 self.look_falling(i, j, &mut best);
             } else {

@@ -169,7 +169,7 @@ impl EventEngine {
 
     /// Whether circle `i`'s supports hold it against gravity: a support right under it, or two
     /// on either side of straight down (one may be a wall beside it), among the walls, segment
-    /// walls and circles at rest that it touches (to within ten rest heights' gap).
+    /// walls and circles at rest that it meets and touches (to within ten rest heights' gap).
     fn held(&self, i: usize) -> bool {
         let up = -self.gravity.normalize_or_zero();
         let (p, r) = (self.motion[i].pos, self.motion[i].radius);
@@ -199,7 +199,7 @@ impl EventEngine {
         for j in near.chain(self.large.iter().map(|&j| j as usize)) {
             let resting =
                 self.asleep[j] || (self.inv_mass[j] == 0.0 && self.velocity(j) == DVec2::ZERO);
-            if j == i || !resting {
+            if j == i || !resting || !self.meets(i, j) {
                 continue;
             }
             let d = self.offset(self.position(j), p);

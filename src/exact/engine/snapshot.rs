@@ -192,6 +192,7 @@ impl EventEngine {
             segments,
             segment_cells,
             own_restitution: Vec::new(),
+            layers: Vec::new(),
             hits: None,
             growth: 0.0,
             large,

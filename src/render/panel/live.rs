@@ -11,6 +11,7 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
+use crate::collision_layers::{CollisionLayers, Sensor, solver_layers};
 use crate::components::{Position, Radius};
 use crate::config::Solver;
 use crate::diagnostics::{CircleDiagnostics, Pressure};
@@ -76,7 +77,7 @@ pub(super) fn sample(
     pairs: Res<PairCollisions>,
     diagnostics: Res<CircleDiagnostics>,
     arena: Res<Arena>,
-    circles: Query<(&Position, &Radius)>,
+    circles: Query<(&Position, &Radius, Option<&CollisionLayers>, Has<Sensor>)>,
     mut timer: ResMut<StepTimer>,
     mut history: ResMut<LiveHistory>,
 ) {
@@ -96,7 +97,6 @@ pub(super) fn sample(
     // Counters restart at a reset: a window that spans one measures nothing.
     let window = totals.since(&then_totals);
     let window_pairs = pairs.since(&then_pairs);
-    let discs: Vec<_> = circles.iter().map(|(p, r)| (p.0, r.0)).collect();
     let z = Pressure::virial_z(
         &window,
         &window_pairs,
@@ -110,7 +110,13 @@ pub(super) fn sample(
         collisions_per_second: (window.sim_seconds > 0.0)
             .then(|| window_pairs.count as f64 / window.sim_seconds),
         z,
-        overlap: Overlaps::measure(&discs, &arena).max,
+        overlap: Overlaps::measure_layered(
+            circles
+                .iter()
+                .map(|(p, r, l, s)| (p.0, r.0, solver_layers(l, s))),
+            &arena,
+        )
+        .max,
         energy_drift: diagnostics.energy_drift(),
     };
     if history.samples.len() == HISTORY_LEN {
