@@ -1,7 +1,8 @@
 //! Whole-App benchmarks: one `app.update()` (exactly one fixed step) of a headless app, after
 //! `finish()`, spawning and one warm-up step. Per solver on gases of growing N, and the price of
 //! effects: a no-collision scene against the same scene with collisions and against bare
-//! integration; collision messages off and on; a gas without and among 2000 segment walls; a
+//! integration; collision messages off and on; layers and sensors; a gas without and among
+//! 2000 segment walls; a
 //! sparse step, where the step's own work is all there is; and the pile scenes once they rest.
 //!
 //! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver and
@@ -9,6 +10,7 @@
 
 mod common;
 
+use bevy::prelude::{App, Entity, With};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use moving_circles::prelude::*;
 use moving_circles::run::headless_app;
@@ -16,7 +18,11 @@ use moving_circles::run::headless_app;
 use common::gas;
 
 fn bench_config(c: &mut Criterion, group: &str, id: BenchmarkId, n: usize, config: CirclesConfig) {
-    let mut app = headless_app(config);
+    bench_app(c, group, id, n, headless_app(config));
+}
+
+/// [`bench_config`] on an app already built (and changed by the caller).
+fn bench_app(c: &mut Criterion, group: &str, id: BenchmarkId, n: usize, mut app: App) {
     app.update(); // warm-up step
     let mut group = c.benchmark_group(group);
     group
@@ -91,6 +97,47 @@ fn hit_messages(c: &mut Criterion) {
             };
             let name = format!("{solver}/{}", if on { "on" } else { "off" });
             bench_config(c, "step_hit_messages", BenchmarkId::new(name, n), n, config);
+        }
+    }
+}
+
+/// What layers and sensors cost: the walled 10k gas as it is (`plain`), split into two teams
+/// that meet only themselves (`teams`: every circle has layers, half the pairs are skipped),
+/// and with 16 still sensor zones among the circles (`sensors`), under `discrete`, `soft=4`
+/// and `exact`. `plain` is the price a scene without layers pays (nothing is gathered).
+fn layers(c: &mut Criterion) {
+    let n = 10_000;
+    for solver in [Solver::Discrete, Solver::Soft(4), Solver::Exact] {
+        for variant in ["plain", "teams", "sensors"] {
+            let mut app = headless_app(gas(n, solver));
+            let world = app.world_mut();
+            let circles: Vec<Entity> = world
+                .query_filtered::<Entity, With<Radius>>()
+                .iter(world)
+                .collect();
+            match variant {
+                "teams" => {
+                    for (k, &e) in circles.iter().enumerate() {
+                        let team = 1 << (1 + k % 2);
+                        world.entity_mut(e).insert(CollisionLayers::new(team, team));
+                    }
+                }
+                "sensors" => {
+                    let arena = *world.resource::<Arena>();
+                    for k in 0..16 {
+                        let at = arena.min
+                            + arena.size()
+                                * bevy::math::DVec2::new(
+                                    (k % 4) as f64 / 4.0 + 0.125,
+                                    (k / 4) as f64 / 4.0 + 0.125,
+                                );
+                        world.spawn((Radius(2.0), Position(at), Mass::IMMOVABLE, Sensor));
+                    }
+                }
+                _ => {}
+            }
+            let id = BenchmarkId::new(format!("{solver}/{variant}"), n);
+            bench_app(c, "step_layers", id, n, app);
         }
     }
 }
@@ -228,6 +275,7 @@ criterion_group!(
     solvers,
     effects,
     hit_messages,
+    layers,
     segments,
     eos_point,
     sparse_step,
