@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::CirclesPlugins;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, inertia, snapshot, snapshot_with_entities};
+use crate::circle::{CircleState, discs, inertia, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
 use crate::collision_layers::{CollisionLayers, Sensor, solver_layers};
@@ -181,8 +181,16 @@ pub fn sample_end(
     }
 }
 
-/// The overlaps between the circles of `world` that meet.
-fn overlaps_in(world: &mut World, arena: &Arena) -> Overlaps {
+/// The overlaps between the circles of `world` that meet: those of `circles` (its snapshot,
+/// if taken) when no circle has layers or is a sensor.
+fn overlaps_in(world: &mut World, circles: Option<&[CircleState]>, arena: &Arena) -> Overlaps {
+    let mut filtered = world.query_filtered::<(), Or<(With<CollisionLayers>, With<Sensor>)>>();
+    if filtered.iter(world).next().is_none() {
+        return match circles {
+            Some(circles) => Overlaps::measure(&discs(circles), arena, &[]),
+            None => Overlaps::measure(&discs(&snapshot(world)), arena, &[]),
+        };
+    }
     let mut circles = world.query::<(&Position, &Radius, Option<&CollisionLayers>, Has<Sensor>)>();
     let layered = circles
         .iter(world)
@@ -194,7 +202,9 @@ fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl Fn
     let step = world.resource::<StepTotals>().steps;
     let circles = snapshot(world);
     let arena = *world.resource::<Arena>();
-    progress.overlaps.add(overlaps_in(world, &arena));
+    progress
+        .overlaps
+        .add(overlaps_in(world, Some(&circles), &arena));
     observe(Sample {
         step,
         circles: &circles,
@@ -325,7 +335,7 @@ impl Report {
         let pairs = *world.resource::<PairCollisions>();
         let walls = *world.resource::<WallCollisions>();
         let arena = *world.resource::<Arena>();
-        let final_overlaps = overlaps_in(world, &arena);
+        let final_overlaps = overlaps_in(world, None, &arena);
         let sleeping = world
             .query::<&Sleep>()
             .iter(world)

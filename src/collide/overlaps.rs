@@ -70,10 +70,14 @@ impl Overlaps {
         circles: impl Iterator<Item = (DVec2, f64, CollisionLayers)>,
         arena: &Arena,
     ) -> Self {
-        let (discs, mut layers): (Vec<_>, Vec<_>) =
-            circles.map(|(p, r, layers)| ((p, r), layers)).unzip();
-        if layers.iter().all(|&l| l == CollisionLayers::DEFAULT) {
-            layers.clear();
+        let (mut discs, mut layers) = (Vec::new(), Vec::new());
+        for (p, r, own) in circles {
+            // Layers listed from the first circle that has its own on (none: all meet).
+            if !layers.is_empty() || own != CollisionLayers::DEFAULT {
+                layers.resize(discs.len(), CollisionLayers::DEFAULT);
+                layers.push(own);
+            }
+            discs.push((p, r));
         }
         Self::measure(&discs, arena, &layers)
     }
@@ -92,5 +96,29 @@ impl Overlaps {
         } else {
             self.sum / self.pairs as f64
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pairs_that_do_not_meet_are_not_counted_wherever_their_layers_start() {
+        let ghost = CollisionLayers::new(0b10, 0b10);
+        let arena = Arena::default();
+        // Three circles in a row, each overlapping the next by 0.25.
+        let at = |x: f64| (DVec2::new(x, 0.0), 0.5);
+        let row = |layers: [CollisionLayers; 3]| {
+            let circles = [0.0, 0.75, 1.5].map(at);
+            let measured = circles.iter().zip(layers).map(|(&(p, r), l)| (p, r, l));
+            Overlaps::measure_layered(measured, &arena).pairs
+        };
+        let plain = CollisionLayers::DEFAULT;
+        assert_eq!(row([plain; 3]), 2);
+        assert_eq!(row([plain, plain, ghost]), 1);
+        assert_eq!(row([ghost, plain, plain]), 1);
+        assert_eq!(row([plain, ghost, plain]), 0);
+        assert_eq!(row([ghost, ghost, CollisionLayers::ALL]), 2);
     }
 }

@@ -149,13 +149,8 @@ fn update_sleep(
     let dt = time.timestep().as_secs_f64();
     let (resting, islands) = &mut *scratch;
     resting.clear();
-    islands.layers.clear();
-    let filtered = filters.any();
     let (mut stirring, mut asleep, mut ready) = (false, 0usize, false);
-    for (entity, position, velocity, radius, mass, mut sleep, spin) in &mut circles {
-        if filtered {
-            islands.layers.push(filters.of(entity));
-        }
+    for (_, position, velocity, radius, mass, mut sleep, spin) in &mut circles {
         let movable = !mass.is_immovable();
         let moved = |changed: bool, added: bool| changed && !added;
         let spun = spin
@@ -192,6 +187,9 @@ fn update_sleep(
             sleep: *sleep,
         });
     }
+    // Layers only if a circle has them (a pass of its own, so the loop above stays as tight
+    // without them).
+    islands.layers = filters.gather(circles.iter().map(|c| c.0));
     let mut changed = false;
     if asleep > 0 && stirring {
         changed |= !wake_touched(resting, &arena, config.time, islands).is_empty();

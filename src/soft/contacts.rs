@@ -235,31 +235,39 @@ pub fn find_contacts(
     let fall = rules.gravity.length() * dt * dt;
     let travel = |i: usize| bodies.velocity[i].length() * dt + fall;
     if rules.collisions {
-        // Circles that meet nothing (sensors) stay out of the search, so they change neither
-        // its cells nor the order of the contacts.
-        scratch.searched.clear();
-        let layers = &bodies.layers;
-        let searched = (0..bodies.len() as u32)
-            .filter(|&i| layers.is_empty() || meets_any(layers[i as usize]));
-        scratch.searched.extend(searched);
-        scratch.reach.clear();
-        scratch.reach.extend(scratch.searched.iter().map(|&i| {
-            let i = i as usize;
+        // With layers, circles that meet nothing (sensors) stay out of the search, so they
+        // change neither its cells nor the order of the contacts; `searched` lists the others.
+        let (layers, all) = (&bodies.layers, bodies.layers.is_empty());
+        let reach_of = |i: usize| {
             let r = bodies.radius[i];
             (
                 bodies.position[i],
                 r * (1.0 + SPECULATIVE_MARGIN) + travel(i),
             )
-        }));
+        };
+        scratch.searched.clear();
+        scratch.reach.clear();
+        if all {
+            scratch.reach.extend((0..bodies.len()).map(reach_of));
+        } else {
+            let searched = (0..bodies.len() as u32).filter(|&i| meets_any(layers[i as usize]));
+            scratch.searched.extend(searched);
+            let reach = scratch.searched.iter().map(|&i| reach_of(i as usize));
+            scratch.reach.extend(reach);
+        }
         scratch.candidates.clear();
         let (reach, candidates) = (&scratch.reach, &mut scratch.candidates);
         overlapping_pairs(&mut scratch.cells, arena, reach, candidates);
+        let searched = &scratch.searched;
         for &(k, l) in candidates.iter() {
-            let (i, j) = (scratch.searched[k as usize], scratch.searched[l as usize]);
-            if !pair_meets(layers, i as usize, j as usize) {
+            let (i, j) = match all {
+                true => (k as usize, l as usize),
+                false => (searched[k as usize] as usize, searched[l as usize] as usize),
+            };
+            if !pair_meets(layers, i, j) {
                 continue;
             }
-            if let Some(c) = pair_contact(bodies, arena, rules, (i as usize, j as usize)) {
+            if let Some(c) = pair_contact(bodies, arena, rules, (i, j)) {
                 pairs.push(c);
             }
         }

@@ -47,30 +47,26 @@ impl EventEngine {
     ) -> BestPair {
         let me = self.motion[i];
         let mut best = NO_PAIR;
-        // With layers, a pair that does not meet has no event (a branch the same way for every
-        // neighbour without them).
-        let mine = self.layers.get(i).copied();
         let mut look = |j: usize| {
-            if let Some(mine) = mine
-                && !mine.meets(self.layers[j])
-            {
-                return;
-            }
             if FALL {
                 self.look_falling(i, j, &mut best);
             } else {
                 self.look_at::<IMAGES>(&me, j, &mut best);
             }
         };
+        // With layers, a pair that does not meet has no event (a branch the same way for every
+        // neighbour without them; outside `look`, which must stay small enough to inline).
+        let mine = self.layers.get(i).copied();
+        let meets = |j: usize| mine.is_none_or(|mine| mine.meets(self.layers[j]));
         for c in cells {
             for j in self.cells.members(c) {
-                if j != i {
+                if j != i && meets(j) {
                     look(j);
                 }
             }
         }
         for &j in &self.large {
-            if j as usize != i {
+            if j as usize != i && meets(j as usize) {
                 look(j as usize);
             }
         }
