@@ -478,3 +478,48 @@ fn spatial_queries_filter_by_membership_and_leave_sensors_out_on_request() {
     }
     assert!(checked > 50, "{checked} queries found something");
 }
+
+#[test]
+fn a_sensor_sweeping_through_a_sleeping_heap_wakes_none_of_it() {
+    for solver in [Solver::Discrete, Solver::Substeps(4), Solver::Soft(4)] {
+        let mut app = create_app(CirclesConfig {
+            arena: Arena::centered(DVec2::new(8.0, 8.0)),
+            solver,
+            spawn: SpawnConfig {
+                count: 0,
+                ..default()
+            },
+            effects: Effects {
+                gravity: Some(DVec2::new(0.0, -9.81)),
+                restitution: 0.0,
+                wall_restitution: 0.0,
+                ..default()
+            },
+            ..default()
+        });
+        // A row of balls on the floor.
+        for k in 0..6 {
+            let x = -2.5 + k as f64;
+            spawn_circle(&mut app, DVec2::new(x, -3.6), DVec2::ZERO, 0.4, 1.0);
+        }
+        step(&mut app, 240);
+        let asleep = |app: &App| app.world().resource::<Sleeping>().count;
+        assert_eq!(asleep(&app), 6, "{solver}: the row fell asleep");
+        // A kinematic sensor sweeping along the row through every ball.
+        app.world_mut().spawn((
+            Radius(0.5),
+            Position(DVec2::new(-3.5, -3.6)),
+            Velocity(DVec2::new(2.0, 0.0)),
+            Mass::IMMOVABLE,
+            Sensor,
+        ));
+        for n in 0..180 {
+            app.update();
+            assert_eq!(
+                asleep(&app),
+                6,
+                "{solver}: step {n}, the sensor woke a ball"
+            );
+        }
+    }
+}

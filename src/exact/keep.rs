@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use super::engine::{EngineSnapshot, EventEngine, EventStats, Rest, Roughness};
 use crate::arena::Arena;
 use crate::circle::CircleState;
-use crate::collision_layers::{CircleFilters, CollisionLayers, Sensor};
+use crate::collision_layers::CircleFilters;
 use crate::components::{
     AngularVelocity, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep, SolverCircles,
     SpinCircles, Velocity,
@@ -115,8 +115,6 @@ pub(super) type ChangedCircles<'w, 's> = Query<
             Changed<Radius>,
             Changed<Mass>,
             Changed<Restitution>,
-            Changed<CollisionLayers>,
-            Changed<Sensor>,
         )>,
     ),
 >;
@@ -149,7 +147,8 @@ pub(super) type EngineViews = (
 /// What circles have of their own beyond their motion, as the continuous step gathers it.
 pub(super) struct Own<'a> {
     /// Whether a circle lost its own restitution, moment of inertia, layers or sensor since
-    /// the last step (a kept engine cannot tell).
+    /// the last step, or had its layers set or changed or became a sensor (a kept engine cannot
+    /// tell).
     pub lost: bool,
     /// Whether any circle has its own restitution.
     pub restitution: bool,
@@ -173,7 +172,7 @@ pub(super) fn gather_into_engine(
     let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
     let reason = match (&mut state.engine, solver) {
         (Some(_), Solver::Exact) if own.lost => {
-            "a circle lost its restitution, moment of inertia, layers or sensor"
+            "a circle lost its restitution or moment of inertia, or its layers changed"
         }
         (Some(_), Solver::Exact) if state.reordered => "circles moved between archetypes",
         (Some(engine), Solver::Exact)
@@ -199,8 +198,7 @@ pub(super) fn gather_into_engine(
             }
             let known = (state.entities.len(), &state.index);
             let changed = (&changed[..], &turned[..]);
-            let body_of = (restitution_of, own.filters);
-            match moved_since(engine, known, changed, &all, body_of) {
+            match moved_since(engine, known, changed, &all, restitution_of) {
                 Ok(moved) if moved.is_empty() => return,
                 Ok(moved) if moved.len() <= all.iter().len() / MOVED_FOR_REBUILD => {
                     for m in &moved {
@@ -302,14 +300,14 @@ struct Turning {
 /// Of the `changed` circles (written since the kept `engine` last wrote them, or spawned), with
 /// how each turns now (in a rough engine; none in a smooth one), those user code moved,
 /// steered or turned; or why the engine cannot be kept (a circle came, went, or changed its
-/// radius, mass, restitution, layers or moment of inertia). `known` holds how many circles the
-/// engine has and each one's index by entity.
+/// radius, mass, restitution or moment of inertia). `known` holds how many circles the engine
+/// has and each one's index by entity.
 fn moved_since(
     engine: &EventEngine,
     known: (usize, &EntityHashMap<usize>),
     (changed, turned): (&[Entity], &[Turning]),
     circles: &SolverCircles,
-    (restitution_of, filters): (impl Fn(Option<&Restitution>) -> f64, &CircleFilters),
+    restitution_of: impl Fn(Option<&Restitution>) -> f64,
 ) -> Result<Vec<Moved>, &'static str> {
     let (count, index) = known;
     if circles.iter().len() != count {
@@ -323,9 +321,6 @@ fn moved_since(
         };
         if engine.body(i) != (r.0, m.inverse(), restitution_of(e)) {
             return Err("a radius, mass or restitution changed");
-        }
-        if filters.of(entity) != engine.layers(i) {
-            return Err("a circle's layers changed or it became a sensor");
         }
         let motion = ((p.0, v.0) != (engine.position(i), engine.velocity(i))).then_some((p.0, v.0));
         let turning = turned.get(k);

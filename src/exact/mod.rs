@@ -30,7 +30,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
 use crate::collision_layers::{CircleFilters, CollisionLayers, Sensor};
-use crate::components::{Inertia, Restitution, Sleep, SolverCircles, SpinCircles};
+use crate::components::{Inertia, Radius, Restitution, Sleep, SolverCircles, SpinCircles};
 use crate::config::{Effects, Solver};
 use crate::hits::{CircleHit, WallHit};
 use crate::integrate::turn_circles;
@@ -84,6 +84,13 @@ struct StepSetup<'w> {
     stop: Option<Res<'w, StopRequest>>,
 }
 
+/// The circles whose layers were set or changed, or that became sensors, since the last step:
+/// a query of its own, which matches nothing (and costs nothing) in a scene without layers.
+type Relayered = (
+    With<Radius>,
+    Or<(Changed<CollisionLayers>, Changed<Sensor>)>,
+);
+
 /// The components a circle may lose that a kept engine cannot tell it lost.
 #[derive(SystemParam)]
 struct Lost<'w, 's> {
@@ -115,7 +122,7 @@ fn continuous_step(
     setup: StepSetup,
     mut state: ResMut<EngineState>,
     own: (Query<(), With<Restitution>>, CircleFilters),
-    mut lost: Lost,
+    (mut lost, relayered): (Lost, Query<(), Relayered>),
     mut circles: ParamSet<EngineViews>,
     mut counted: Counted,
     messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
@@ -130,7 +137,7 @@ fn continuous_step(
     } = setup;
     let (own_restitution, filters) = own;
     let own = Own {
-        lost: lost.any(),
+        lost: lost.any() || !relayered.is_empty(),
         restitution: !own_restitution.is_empty(),
         filters: &filters,
     };

@@ -118,7 +118,6 @@ type SleepingCircles<'w, 's> = Query<
     'w,
     's,
     (
-        Entity,
         Ref<'static, Position>,
         Mut<'static, Velocity>,
         Ref<'static, Radius>,
@@ -127,6 +126,15 @@ type SleepingCircles<'w, 's> = Query<
         Option<Mut<'static, AngularVelocity>>,
     ),
 >;
+
+/// The entities of [`SleepingCircles`], in its order (the same components).
+type SleepingOnly = (
+    With<Position>,
+    With<Velocity>,
+    With<Radius>,
+    With<Mass>,
+    With<Sleep>,
+);
 
 /// Before each step of a time-stepped solver: wakes sleeping circles that your code moved,
 /// advances every awake circle's time at rest, wakes the sleeping circles a circle not at rest
@@ -139,7 +147,7 @@ fn update_sleep(
     totals: Res<StepTotals>,
     mut sleeping: ResMut<Sleeping>,
     mut scratch: Local<SleepScratch>,
-    (mut circles, filters): (SleepingCircles, CircleFilters),
+    (mut circles, entities, filters): (SleepingCircles, Query<Entity, SleepingOnly>, CircleFilters),
 ) {
     let (effects, arena, solver, time) = settings;
     if solver.is_continuous() {
@@ -150,7 +158,7 @@ fn update_sleep(
     let (resting, islands) = &mut *scratch;
     resting.clear();
     let (mut stirring, mut asleep, mut ready) = (false, 0usize, false);
-    for (_, position, velocity, radius, mass, mut sleep, spin) in &mut circles {
+    for (position, velocity, radius, mass, mut sleep, spin) in &mut circles {
         let movable = !mass.is_immovable();
         let moved = |changed: bool, added: bool| changed && !added;
         let spun = spin
@@ -187,9 +195,11 @@ fn update_sleep(
             sleep: *sleep,
         });
     }
-    // Layers only if a circle has them (a pass of its own, so the loop above stays as tight
-    // without them).
-    islands.layers = filters.gather(circles.iter().map(|c| c.0));
+    // Layers only if a circle has them, from a query of their own (the same circles in the
+    // same order: an entity in the loop above costs a scene without layers 1.5 % of a pile's
+    // step).
+    islands.layers = filters.gather(entities);
+    debug_assert!(islands.layers.is_empty() || islands.layers.len() == resting.len());
     let mut changed = false;
     if asleep > 0 && stirring {
         changed |= !wake_touched(resting, &arena, config.time, islands).is_empty();
@@ -198,7 +208,7 @@ fn update_sleep(
         changed |= !fall_asleep(resting, &arena, config.time, islands).is_empty();
     }
     if changed {
-        for (i, (_, _, mut velocity, _, _, mut sleep, spin)) in circles.iter_mut().enumerate() {
+        for (i, (_, mut velocity, _, _, mut sleep, spin)) in circles.iter_mut().enumerate() {
             if *sleep != resting[i].sleep {
                 *sleep = resting[i].sleep;
                 if sleep.asleep && velocity.0 != DVec2::ZERO {
