@@ -43,13 +43,16 @@ use crate::query::index::CircleIndex;
 use crate::schedule::CircleSystems;
 
 /// Finds what overlaps each sensor after every fixed step, in [`CircleSystems::Sensors`]
-/// (part of [`CirclesPlugins`](crate::CirclesPlugins)). A world without sensors runs nothing.
+/// (part of [`CirclesPlugins`](crate::CirclesPlugins)), and registers [`CollisionLayers`] and
+/// [`Sensor`] for reflection. A world without sensors runs nothing.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SensorPlugin;
 
 impl Plugin for SensorPlugin {
     fn build(&self, app: &mut App) {
-        app.add_message::<OverlapStarted>()
+        app.register_type::<CollisionLayers>()
+            .register_type::<Sensor>()
+            .add_message::<OverlapStarted>()
             .add_message::<OverlapEnded>()
             .add_systems(
                 FixedUpdate,
