@@ -17,11 +17,15 @@ use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+/// A circle's memberships and filters, written out: a circle without layers is in group 0 and
+/// meets every group.
+fn masks(layers: Option<CollisionLayers>) -> (u32, u32) {
+    layers.map_or((1, u32::MAX), |l| (l.memberships, l.filters))
+}
+
 /// Whether two circles meet, written out from the definition: neither is a sensor, and each is
-/// in a group the other meets (a circle without layers is in group 0 and meets every group).
+/// in a group the other meets.
 fn brute_meets(a: (Option<CollisionLayers>, bool), b: (Option<CollisionLayers>, bool)) -> bool {
-    let masks =
-        |l: Option<CollisionLayers>| l.map_or((1, u32::MAX), |l| (l.memberships, l.filters));
     let ((ma, fa), (mb, fb)) = (masks(a.0), masks(b.0));
     !a.1 && !b.1 && (ma & fb) != 0 && (mb & fa) != 0
 }
@@ -201,47 +205,59 @@ proptest! {
     }
 }
 
-/// Two circles of radius 0.5 head on at ±3, speed 1: they touch at t = 2.5.
-fn head_on(app: &mut App) -> (Entity, Entity) {
-    spawn_head_on(app, 3.0, 1.0, 0.5)
+/// Two circles of radius 0.5 head on at ±3, speed 1 (they touch at t = 2.5) under `solver`:
+/// `before` changes them before the first step, `after` after one second, then two more
+/// seconds run. Returns the app and the left circle.
+fn head_on_course(
+    solver: Solver,
+    before: impl FnOnce(&mut World, Entity, Entity),
+    after: impl FnOnce(&mut World, Entity, Entity),
+) -> (App, Entity) {
+    let mut app = empty_box(solver);
+    let (a, b) = spawn_head_on(&mut app, 3.0, 1.0, 0.5);
+    before(app.world_mut(), a, b);
+    step(&mut app, 60); // 1 s: still 2 apart
+    after(app.world_mut(), a, b);
+    step(&mut app, 120);
+    (app, a)
 }
 
 #[test]
 fn layers_set_removed_or_a_sensor_added_by_game_code_take_effect_at_the_next_step() {
     let ghost = CollisionLayers::new(0b10, 0b10);
+    let nothing = |_: &mut World, _: Entity, _: Entity| {};
     for solver in EVERY_SOLVER {
-        // Passing through, then made to meet before they touch: they bounce.
-        let mut app = empty_box(solver);
-        let (a, b) = head_on(&mut app);
-        app.world_mut().entity_mut(a).insert(ghost);
-        step(&mut app, 60); // 1 s: still 2 apart, the kept engine predicted no hit
-        app.world_mut().entity_mut(a).remove::<CollisionLayers>();
-        step(&mut app, 120);
+        // Passing through (the kept engine predicted no hit), then made to meet before they
+        // touch: they bounce.
+        let (app, a) = head_on_course(
+            solver,
+            |world, a, _| {
+                world.entity_mut(a).insert(ghost);
+            },
+            |world, a, _| {
+                world.entity_mut(a).remove::<CollisionLayers>();
+            },
+        );
         assert_eq!(pair_collisions(&app), 1, "{solver}: layers removed");
         assert!(state(&app, a).1.x < 0.0, "{solver}: a bounced back");
 
         // Meeting, then made a ghost before they touch: they pass through.
-        let mut app = empty_box(solver);
-        let (a, b2) = head_on(&mut app);
-        step(&mut app, 60);
-        app.world_mut().entity_mut(b2).insert(ghost);
-        step(&mut app, 120);
+        let (app, a) = head_on_course(solver, nothing, |world, _, b| {
+            world.entity_mut(b).insert(ghost);
+        });
         assert_eq!(pair_collisions(&app), 0, "{solver}: layers set");
         assert_eq!(state(&app, a).1, DVec2::X, "{solver}: a flew on");
 
         // Made a sensor: the same.
-        let mut app = empty_box(solver);
-        let (a, b3) = head_on(&mut app);
-        step(&mut app, 60);
-        app.world_mut().entity_mut(b3).insert(Sensor);
-        step(&mut app, 120);
+        let (app, a) = head_on_course(solver, nothing, |world, _, b| {
+            world.entity_mut(b).insert(Sensor);
+        });
         assert_eq!(pair_collisions(&app), 0, "{solver}: made a sensor");
         assert_eq!(
             state(&app, a).1,
             DVec2::X,
             "{solver}: a flew through the sensor"
         );
-        let _ = b;
     }
 }
 
@@ -295,8 +311,6 @@ fn brute_sensor_overlaps(app: &mut App) -> Vec<(Entity, Vec<Entity>)> {
         .iter(app.world())
         .map(|(e, p, r, l, s)| (e, p.0, r.0, l.copied(), s))
         .collect();
-    let masks =
-        |l: Option<CollisionLayers>| l.map_or((1, u32::MAX), |l| (l.memberships, l.filters));
     let mut found = Vec::new();
     for &(sensor, p, r, l, is_sensor) in &all {
         if !is_sensor {
