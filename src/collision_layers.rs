@@ -28,9 +28,10 @@
 //! ```
 
 use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::Radius;
+use crate::components::{Position, Radius};
 
 /// The groups a circle belongs to (`memberships`) and the groups it meets (`filters`), one bit
 /// per group, up to 32 groups. Two circles meet when each is in a group the other meets
@@ -133,13 +134,28 @@ pub struct OverlapEnded {
     pub circle: Entity,
 }
 
-/// The circles that have layers or are sensors.
-type Filtered = (With<Radius>, Or<(With<CollisionLayers>, With<Sensor>)>);
+/// The circles that have layers or are sensors (none in a scene without layers).
+pub type Layered = (With<Radius>, Or<(With<CollisionLayers>, With<Sensor>)>);
+
+/// What the overlap measures read of a circle: centre, radius, layers, sensor.
+pub type LayeredDisc = (
+    &'static Position,
+    &'static Radius,
+    Option<&'static CollisionLayers>,
+    Has<Sensor>,
+);
+
+/// A [`LayeredDisc`] as centre, radius and the layers the solvers give it ([`solver_layers`]).
+pub fn layered_disc(
+    (position, radius, layers, sensor): (&Position, &Radius, Option<&CollisionLayers>, bool),
+) -> (DVec2, f64, CollisionLayers) {
+    (position.0, radius.0, solver_layers(layers, sensor))
+}
 
 /// Each circle's layers as the solvers see them ([`solver_layers`]).
 #[derive(SystemParam)]
 pub struct CircleFilters<'w, 's> {
-    any: Query<'w, 's, (), Filtered>,
+    any: Query<'w, 's, (), Layered>,
     each: Query<'w, 's, (Option<&'static CollisionLayers>, Has<Sensor>), With<Radius>>,
 }
 

@@ -17,8 +17,8 @@ use crate::boundary::WallCollisions;
 use crate::circle::{CircleState, discs, inertia, snapshot, snapshot_with_entities};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::collision_layers::{CollisionLayers, Sensor, solver_layers};
-use crate::components::{Inertia, Position, Radius, Sleep};
+use crate::collision_layers::{Layered, LayeredDisc, layered_disc};
+use crate::components::{Inertia, Sleep};
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
@@ -184,18 +184,19 @@ pub fn sample_end(
 /// The overlaps between the circles of `world` that meet: those of `circles` (its snapshot,
 /// if taken) when no circle has layers or is a sensor.
 fn overlaps_in(world: &mut World, circles: Option<&[CircleState]>, arena: &Arena) -> Overlaps {
-    let mut filtered = world.query_filtered::<(), Or<(With<CollisionLayers>, With<Sensor>)>>();
-    if filtered.iter(world).next().is_none() {
+    if world
+        .query_filtered::<(), Layered>()
+        .iter(world)
+        .next()
+        .is_none()
+    {
         return match circles {
             Some(circles) => Overlaps::measure(&discs(circles), arena, &[]),
             None => Overlaps::measure(&discs(&snapshot(world)), arena, &[]),
         };
     }
-    let mut circles = world.query::<(&Position, &Radius, Option<&CollisionLayers>, Has<Sensor>)>();
-    let layered = circles
-        .iter(world)
-        .map(|(p, r, l, s)| (p.0, r.0, solver_layers(l, s)));
-    Overlaps::measure_layered(layered, arena)
+    let mut circles = world.query::<LayeredDisc>();
+    Overlaps::measure_layered(circles.iter(world).map(layered_disc), arena)
 }
 
 fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl FnMut(Sample)) {

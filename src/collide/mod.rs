@@ -73,7 +73,8 @@ impl PairCollisions {
 }
 
 /// Gathers the circles (with their layers, if any circle has them), resolves their contacts
-/// with [`resolve_all_contacts`] and writes back what changed; with `effects.hit_messages`, writes a [`CircleHit`] per collision.
+/// with [`resolve_all_contacts`] and writes back what changed; with `effects.hit_messages`,
+/// writes a [`CircleHit`] per collision.
 #[allow(clippy::too_many_arguments)]
 fn collide_circles(
     arena: Res<Arena>,

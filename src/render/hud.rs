@@ -12,8 +12,7 @@ use crate::arena::Arena;
 use crate::boundary::WallCollisions;
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::collision_layers::{CollisionLayers, Sensor, solver_layers};
-use crate::components::{Position, Radius};
+use crate::collision_layers::{LayeredDisc, layered_disc};
 use crate::config::Solver;
 use crate::diagnostics::{CircleDiagnostics, Pressure};
 use crate::schedule::StepTotals;
@@ -150,14 +149,11 @@ fn update_hud(
     solver: Res<Solver>,
     measured: Measured,
     rates: Res<HudRates>,
-    circles: Query<(&Position, &Radius, Option<&CollisionLayers>, Has<Sensor>)>,
+    circles: Query<LayeredDisc>,
     mut text: Single<&mut Text, With<HudText>>,
 ) {
     // Overlaps are measured here, at the HUD's refresh rate, not every step.
-    let layered = circles
-        .iter()
-        .map(|(p, r, l, s)| (p.0, r.0, solver_layers(l, s)));
-    let overlaps = Overlaps::measure_layered(layered, &measured.arena);
+    let overlaps = Overlaps::measure_layered(circles.iter().map(layered_disc), &measured.arena);
     let d = &*measured.diagnostics;
     let pressure = Pressure::measure(
         &measured.elapsed,

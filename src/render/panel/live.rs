@@ -11,8 +11,7 @@ use bevy::prelude::*;
 use crate::arena::Arena;
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::collision_layers::{CollisionLayers, Sensor, solver_layers};
-use crate::components::{Position, Radius};
+use crate::collision_layers::{LayeredDisc, layered_disc};
 use crate::config::Solver;
 use crate::diagnostics::{CircleDiagnostics, Pressure};
 use crate::schedule::StepTotals;
@@ -77,7 +76,7 @@ pub(super) fn sample(
     pairs: Res<PairCollisions>,
     diagnostics: Res<CircleDiagnostics>,
     arena: Res<Arena>,
-    circles: Query<(&Position, &Radius, Option<&CollisionLayers>, Has<Sensor>)>,
+    circles: Query<LayeredDisc>,
     mut timer: ResMut<StepTimer>,
     mut history: ResMut<LiveHistory>,
 ) {
@@ -110,13 +109,7 @@ pub(super) fn sample(
         collisions_per_second: (window.sim_seconds > 0.0)
             .then(|| window_pairs.count as f64 / window.sim_seconds),
         z,
-        overlap: Overlaps::measure_layered(
-            circles
-                .iter()
-                .map(|(p, r, l, s)| (p.0, r.0, solver_layers(l, s))),
-            &arena,
-        )
-        .max,
+        overlap: Overlaps::measure_layered(circles.iter().map(layered_disc), &arena).max,
         energy_drift: diagnostics.energy_drift(),
     };
     if history.samples.len() == HISTORY_LEN {
