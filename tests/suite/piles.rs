@@ -4,13 +4,11 @@
 //! `soft`, a heap of 300 under `exact` and `swept` with no overlap beyond rounding, all asleep;
 //! and the course's solvers, which cannot hold a stack, keep every circle inside and finite.
 
-mod common;
-
 use std::path::Path;
 
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::circle::{CircleState, discs, snapshot};
 use moving_circles::collide::overlaps::Overlaps;
 use moving_circles::prelude::*;

@@ -1,10 +1,8 @@
 //! Free flight and walls: a lone circle moves exactly `v·dt` per step; a wall hit reflects it and
 //! it never leaves the arena.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
-use common::*;
 use moving_circles::prelude::*;
 use moving_circles::schedule::StepDt;
 

@@ -1,11 +1,9 @@
 //! One test per effect: it acts when the scene asks for it, and it has no system (and no
 //! effect) when the scene does not.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 
 fn one_circle(effects: &str, boundary: &str, position: &str, velocity: &str) -> App {
     one_circle_under("discrete", effects, boundary, position, velocity)

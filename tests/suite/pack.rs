@@ -2,12 +2,10 @@
 //! arena to area fraction 0.85 with any radii, walled or periodic, from a scene and from the
 //! command line; a request past jamming is refused, in bounded time, saying how far it got.
 
-mod common;
-
 use std::process::Command;
 
+use crate::common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use bevy::math::DVec2;
-use common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use moving_circles::circle::{discs, snapshot};
 use moving_circles::collide::overlaps::Overlaps;
 use moving_circles::prelude::*;

@@ -5,13 +5,11 @@
 //! background with one row per solver.
 #![cfg(feature = "render")]
 
-mod common;
-
 use std::time::{Duration, Instant};
 
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::accuracy::SOLVERS;
 use moving_circles::prelude::*;
 use moving_circles::render::panel::{

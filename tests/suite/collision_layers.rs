@@ -4,11 +4,9 @@
 //! step by step; layers changed by game code take effect at the next step, also in a kept
 //! `exact` engine; spatial queries filter by membership and leave sensors out on request.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::arena::{Arena, Boundary};
 use moving_circles::circle::CircleState;
 use moving_circles::exact::engine::EventEngine;

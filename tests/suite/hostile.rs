@@ -7,14 +7,12 @@ use std::os::unix::fs::FileTypeExt;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-use common::binary::{assert_refused, moving_circles, under_one_gib};
+use crate::common::binary::{assert_refused, moving_circles, under_one_gib};
 use moving_circles::config::MAX_CIRCLES;
-
-mod common;
 
 /// A scratch folder for the test `name`.
 fn temp_dir(name: &str) -> PathBuf {
-    common::binary::scratch_dir("hostile", name)
+    crate::common::binary::scratch_dir("hostile", name)
 }
 
 /// `run` on two steps of the classic scene, with `extra` flags.
@@ -238,7 +236,7 @@ fn inputs_that_never_end_or_pile_up_are_refused_within_bounded_memory() {
 
 #[test]
 fn work_that_would_take_hours_is_refused_up_front() {
-    // (`--steps` past its range is a usage error: `tests/hostile_two.rs`.)
+    // (`--steps` past its range is a usage error: `tests/suite/hostile_two.rs`.)
     let out = moving_circles(&[
         "run",
         "--scene",

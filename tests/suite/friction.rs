@@ -5,11 +5,9 @@
 //! spin passed between two circles within the Coulomb bound, momentum kept; a circle of its own
 //! moment of inertia (a ring) rolls as its inertia says.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::prelude::*;
 
 const G: f64 = 9.81;

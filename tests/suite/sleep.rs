@@ -2,11 +2,9 @@
 //! it is, a ball dropped onto it wakes it and it sleeps again, your code's writes wake a
 //! sleeping circle, a change of the effects wakes them all, and nothing sleeps without gravity.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::circle::{CircleState, snapshot};
 use moving_circles::prelude::*;
 

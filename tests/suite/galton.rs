@@ -1,12 +1,10 @@
 //! The Galton board scene (`assets/scenes/galton.ron`) headless: every dropped ball lands in a
 //! bin, none escapes the board, none sinks into a peg, and the bins fill in a bell shape.
 
-mod common;
-
 use std::path::Path;
 
+use crate::common::*;
 use bevy::math::DVec2;
-use common::*;
 use moving_circles::prelude::*;
 
 /// The bin walls' x, left to right (the guides are the outer walls), and their top.

@@ -6,13 +6,11 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-use common::binary::{assert_refused, stderr, under_one_gib};
-
-mod common;
+use crate::common::binary::{assert_refused, stderr, under_one_gib};
 
 /// A scratch folder for the test `name`.
 fn temp_dir(name: &str) -> PathBuf {
-    common::binary::scratch_dir("hostile2", name)
+    crate::common::binary::scratch_dir("hostile2", name)
 }
 
 #[test]

@@ -1,13 +1,11 @@
 //! The example scenes and particle files: each loads, runs, and schedules what it calls for;
 //! a scene applied at runtime (hot reload) swaps the effect systems.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::prelude::*;
 use moving_circles::scene::{asset::apply_config, particles};
 

@@ -3,11 +3,9 @@
 //! gave them is counted; user systems spawn, despawn, teleport and resize circles between steps
 //! with no overlap and no stale event.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::circle::snapshot_with_entities;
 use moving_circles::collide::overlaps::overlapping_circles;
 use moving_circles::exact::EngineState;

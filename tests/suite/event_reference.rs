@@ -3,10 +3,8 @@
 //! Any event the engine's cell list, queue or invalidation logic missed or misordered shows up
 //! as a different collision count and a diverging state.
 
-mod common;
-
+use crate::common::unit_box_gas;
 use bevy::math::DVec2;
-use common::unit_box_gas;
 use moving_circles::arena::{Arena, Boundary};
 use moving_circles::circle::CircleState;
 use moving_circles::exact::engine::EventEngine;

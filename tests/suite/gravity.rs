@@ -2,10 +2,8 @@
 //! gas in a box keeps its mechanical energy (kinetic plus potential) to rounding over ten
 //! thousand collisions, at the Earth's gravity and at a thousand times it.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::prelude::*;
 
 fn elastic_box(solver: &str, g: f64) -> App {

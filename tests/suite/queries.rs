@@ -2,8 +2,6 @@
 //! narrow and wide radii on walled, open and periodic arenas, and `SpatialQuery` in an app,
 //! walls and segment walls included, with its filters and the moment it sees a change.
 
-mod common;
-
 use bevy::ecs::system::RunSystemOnce;
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -200,7 +198,7 @@ fn spatial_query_matches_brute_force_with_walls_and_segments() {
             segments: Segments(segments.clone()),
             ..default()
         };
-        let mut app = common::create_app(config);
+        let mut app = crate::common::create_app(config);
         let circles: Vec<(DVec2, f64)> = (0..120)
             .map(|_| {
                 let c = DVec2::new(r.random_range(-5.0..5.0), r.random_range(-4.0..4.0));
@@ -353,7 +351,7 @@ fn spatial_query_matches_brute_force_with_walls_and_segments() {
 /// moved by game code is seen where it was until the next step or a refresh.
 #[test]
 fn queries_see_a_moved_circle_after_the_next_step_or_a_refresh() {
-    let mut app = common::create_app(CirclesConfig::default());
+    let mut app = crate::common::create_app(CirclesConfig::default());
     let ball = app
         .world_mut()
         .spawn((Position(DVec2::ZERO), Radius(0.5)))
@@ -391,7 +389,7 @@ fn queries_see_a_moved_circle_after_the_next_step_or_a_refresh() {
 /// Filters: circles only, walls only, and a caster that leaves itself out.
 #[test]
 fn filters_choose_circles_walls_and_leave_out_the_caster() {
-    let mut app = common::create_app(CirclesConfig {
+    let mut app = crate::common::create_app(CirclesConfig {
         arena: arena(Boundary::Walls),
         ..default()
     });

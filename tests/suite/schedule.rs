@@ -1,12 +1,10 @@
 //! The schedule: no ambiguous system order, only the plugins a config calls for, and parts can be
 //! disabled the Bevy way.
 
-mod common;
-
+use crate::common::*;
 use bevy::app::PluginGroup;
 use bevy::ecs::schedule::{LogLevel, ScheduleBuildSettings};
 use bevy::prelude::*;
-use common::*;
 use moving_circles::prelude::*;
 use moving_circles::schedule::scheduled_systems;
 

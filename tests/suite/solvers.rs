@@ -4,11 +4,9 @@
 //! engine persists across steps and takes in what user code changes; solvers can be switched
 //! mid-run.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::exact::EngineState;
 use moving_circles::prelude::*;
 

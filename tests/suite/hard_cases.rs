@@ -11,16 +11,14 @@
 //! | momentum, where no wall acted | ≤ 1e-9 | ≤ 1e-9 | ≤ 1e-9 | ≤ 1e-9 |
 //! | case-specific promise | ✓ | ✓ | where promised | where promised |
 //!
-//! Run `cargo test --test hard_cases -- --nocapture` to see the measured values.
-
-mod common;
+//! Run `cargo test --test suite hard_cases:: -- --nocapture` to see the measured values.
 
 use std::collections::HashMap;
 use std::path::Path;
 
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::circle::{CircleState, discs, snapshot};
 use moving_circles::collide::overlaps::overlapping_circles;
 use moving_circles::prelude::*;

@@ -2,10 +2,8 @@
 //! time of impact, the contact kernel (impulse + separation), wall reflection, the event
 //! engine and the rough hit. Each property is an invariant the code must keep for every input.
 
-mod common;
-
+use crate::common::unit_box_gas;
 use bevy::math::DVec2;
-use common::unit_box_gas;
 use moving_circles::arena::Arena;
 use moving_circles::boundary::reflect_off_walls;
 use moving_circles::circle::{CircleState, disc_inverse_inertia};

@@ -3,11 +3,9 @@
 //! wedge, and a gas in a maze of segments that never enters a wall. Also what scenes may
 //! declare, and that the effect is scheduled only when a scene has segments.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::exact::EngineState;
 use moving_circles::prelude::*;
 

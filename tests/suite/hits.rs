@@ -2,11 +2,9 @@
 //! exactly the hits the report counts, with sensible contents, in time order within a step;
 //! with messages off it sees none. Per-circle restitution combines as documented.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::prelude::*;
 
 const SOLVERS: [&str; 5] = ["discrete", "substeps=3", "soft", "swept", "exact"];

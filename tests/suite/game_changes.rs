@@ -3,11 +3,9 @@
 //! the segment walls (one put in a circle's path) and the solver (a fast pair that only the
 //! continuous solvers catch).
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::effects::EffectRegistry;
 use moving_circles::prelude::*;
 

@@ -2,11 +2,9 @@
 //! rectangle and on, meet each other out there, are held by segment walls and nothing else,
 //! and a run's checkpoint with circles far outside is read back and resumed.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::checkpoint::Checkpoint;
 use moving_circles::effects::EffectRegistry;
 use moving_circles::prelude::*;

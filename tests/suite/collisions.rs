@@ -1,11 +1,9 @@
 //! Pairwise collisions of the `discrete` solver: head-on swaps, oblique hits conserve momentum and
 //! energy, coincident centres stay finite.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::prelude::*;
 
 #[test]

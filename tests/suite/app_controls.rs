@@ -3,10 +3,8 @@
 //! Bevy's own `how_to_test_systems` does, and the HUD text is read back from the world.
 #![cfg(feature = "render")]
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::diagnostics::Pressure;
 use moving_circles::prelude::*;
 use moving_circles::render::hud::{HelpVisible, HudPlugin, HudRates, HudText};

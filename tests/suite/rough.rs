@@ -5,13 +5,11 @@
 //! state has the ratio of Luding, Huthmann, McNamara and Zippelius (1998); smooth engines are
 //! untouched.
 
-mod common;
-
 use std::f64::consts::PI;
 
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::circle::{CircleState, disc_inertia};
 use moving_circles::exact::EngineState;
 use moving_circles::exact::engine::{EventEngine, Roughness};

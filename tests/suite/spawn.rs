@@ -1,11 +1,9 @@
 //! Spawning: no overlaps, everything inside, reproducible from the seed, and the whole
 //! simulation is deterministic for a seed.
 
-mod common;
-
+use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use common::*;
 use moving_circles::prelude::*;
 use moving_circles::spawn::place_circles;
 

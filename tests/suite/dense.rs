@@ -2,12 +2,10 @@
 //! placement stalls near 0.5), from a scene and from the command line, and the exact solver
 //! melts it with no overlap and energy kept to rounding.
 
-mod common;
-
 use std::process::Command;
 
+use crate::common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use bevy::math::DVec2;
-use common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use moving_circles::circle::{discs, snapshot};
 use moving_circles::collide::overlaps::Overlaps;
 use moving_circles::prelude::*;

@@ -1,0 +1,44 @@
+//! The integration tests, one module per subject, built as one test binary: one link of Bevy
+//! instead of one per file, and every test of the suite run in parallel with the others.
+//! Run one subject with `cargo test --test suite SUBJECT::` (for example `galton::`).
+
+mod common;
+
+mod accuracy;
+mod app_controls;
+mod bad_input;
+mod bodies;
+mod cli;
+mod collision_layers;
+mod collisions;
+mod dense;
+mod docs_links;
+mod effects;
+mod eos;
+mod event_reference;
+mod friction;
+mod galton;
+mod game_changes;
+mod gravity;
+mod hard_cases;
+mod hits;
+mod hostile;
+mod hostile_two;
+mod layers;
+mod motion;
+mod open_arena;
+mod pack;
+mod panel;
+mod piles;
+mod pinned;
+mod properties;
+mod queries;
+mod resume;
+mod rough;
+mod scenes;
+mod schedule;
+mod segments;
+mod sleep;
+mod solvers;
+mod spawn;
+mod transform_sync;
