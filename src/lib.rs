@@ -230,7 +230,7 @@ pub mod prelude {
     };
     pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin, Measuring};
     pub use crate::effects::Effect;
-    pub use crate::exact::ContinuousPlugin;
+    pub use crate::exact::{ContinuousPlugin, EventBudget};
     pub use crate::forces::{DragPlugin, GravityPlugin};
     pub use crate::hits::{ArenaWall, CircleHit, Wall, WallHit};
     pub use crate::integrate::IntegratePlugin;

@@ -13,20 +13,28 @@ use moving_circles::checkpoint::Checkpoint;
 use moving_circles::circle::{CircleState, snapshot};
 use moving_circles::config::{CirclesConfig, Effects, MAX_CIRCLES, Solver};
 use moving_circles::error::InputError;
+use moving_circles::exact::{EXACT_EVENTS_PER_CIRCLE, EventBudget, SWEPT_EVENTS_PER_CIRCLE};
 use moving_circles::io::{MAX_SCENE_BYTES, read_limited};
-use moving_circles::run::{Report, advance, headless_app, run_steps};
+use moving_circles::run::{Report, advance, headless_app_with, run_steps};
 use moving_circles::scene::check::{check_circle, first_overlap};
 use moving_circles::scene::{Scene, particles as particle_file};
 use moving_circles::schedule::StepTotals;
 use moving_circles::segment::{SegmentCells, Segments};
 
 /// Most circles [`simulate`] runs: inputs asking for more are only read and checked. With
-/// [`SIMULATED_STEPS`] this bounds an execution: `exact` processes at most
-/// [`EXACT_EVENTS_PER_CIRCLE`](moving_circles::exact::EXACT_EVENTS_PER_CIRCLE) events per
-/// circle and step (reached only by inelastic collapse or speeds that cross the arena billions
-/// of times a step), so the slowest input costs about 7 M events, a few seconds in the
-/// instrumented build; most cost a millisecond.
+/// [`SIMULATED_STEPS`] and [`FUZZ_BUDGET`] this bounds an execution: the slowest input costs
+/// about 7 k events, milliseconds in the instrumented build, as most inputs do.
 pub const MAX_SIMULATED_CIRCLES: usize = 16;
+
+/// The event budget of the runs here: `exact`'s a thousandth of its default (100 events per
+/// circle and step, far more than a step of a few circles at any ordinary speed needs). Only
+/// inelastic collapse and speeds that cross the arena millions of times a step reach the
+/// default; they reach this one too and take the same path a thousand times sooner (a tenth of
+/// the kept corpus did, at up to 20 s each with the default).
+pub const FUZZ_BUDGET: EventBudget = EventBudget {
+    swept: SWEPT_EVENTS_PER_CIRCLE,
+    exact: EXACT_EVENTS_PER_CIRCLE / 1000,
+};
 
 /// Steps [`simulate`] runs under each solver.
 pub const SIMULATED_STEPS: u64 = 4;
@@ -130,6 +138,7 @@ pub fn checkpoint(data: &[u8]) {
             return;
         }
     };
+    app.insert_resource(FUZZ_BUDGET);
     let resolved = resolvable(&mut app, dt);
     // The overlaps the checkpoint says the run saw are its own: judge the steps run here.
     progress.overlaps = Default::default();
@@ -228,10 +237,15 @@ fn check_circles(circles: &[CircleState], arena: &Arena) {
 /// Runs `config` under `solver` for [`SIMULATED_STEPS`], sampling every step; with the report,
 /// whether its circles were [`resolvable`] at the start.
 fn run(config: &CirclesConfig, solver: Solver) -> (Report, bool) {
-    let mut app = headless_app(CirclesConfig {
-        solver,
-        ..config.clone()
-    });
+    let mut app = headless_app_with(
+        CirclesConfig {
+            solver,
+            ..config.clone()
+        },
+        |app| {
+            app.insert_resource(FUZZ_BUDGET);
+        },
+    );
     let resolved = resolvable(&mut app, config.dt);
     (
         run_steps(&mut app, ORIGIN, SIMULATED_STEPS, 1, |_| {}),

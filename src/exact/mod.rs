@@ -3,7 +3,7 @@
 //!   rebuilds it when something outside changed the circles (a respawn, a drag with the mouse,
 //!   a force effect, a solver switch);
 //! - `swept` builds a fresh engine from the current state every step and resolves that step's
-//!   hits in time order, with a bounded number of events per step ([`SWEPT_EVENTS_PER_CIRCLE`]);
+//!   hits in time order, with a bounded number of events per step ([`EventBudget`]);
 //!   past the bound the rest of the step is free flight and the missed hits resolve next step.
 //!
 //! Both handle walls, periodic edges and collisions themselves (trading spin when the effects
@@ -41,10 +41,46 @@ use keep::{EngineViews, Own, gather_into_engine};
 
 pub use keep::EngineState;
 
-/// Events a `swept` step may process per circle before the rest of the step is free flight.
+/// Events a `swept` step may process per circle before the rest of the step is free flight
+/// (the default of [`EventBudget::swept`]).
 pub const SWEPT_EVENTS_PER_CIRCLE: u64 = 64;
-/// The same bound for `exact`, high enough to be reached only by inelastic collapse.
+/// The same bound for `exact`, high enough to be reached only by inelastic collapse or speeds
+/// that cross the arena millions of times a step (the default of [`EventBudget::exact`]).
 pub const EXACT_EVENTS_PER_CIRCLE: u64 = 100_000;
+
+/// How many events a `swept` or `exact` step may process, per circle (and one circle more),
+/// before the rest of the step is free flight (counted in
+/// [`EngineState::budget_exhausted`]). A game that must bound the work of a frame lowers
+/// `exact`'s; the collisions it skips then show as overlapping, approaching pairs, resolved
+/// next step.
+#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Eq)]
+#[reflect(Resource, Debug)]
+pub struct EventBudget {
+    /// Events per circle and step under `swept`.
+    pub swept: u64,
+    /// Events per circle and step under `exact`.
+    pub exact: u64,
+}
+
+impl Default for EventBudget {
+    fn default() -> Self {
+        Self {
+            swept: SWEPT_EVENTS_PER_CIRCLE,
+            exact: EXACT_EVENTS_PER_CIRCLE,
+        }
+    }
+}
+
+impl EventBudget {
+    /// The events a step of `solver` may process with `circles` circles.
+    pub fn for_step(&self, solver: Solver, circles: usize) -> u64 {
+        let per_circle = match solver {
+            Solver::Swept => self.swept,
+            _ => self.exact,
+        };
+        per_circle.saturating_mul(circles as u64 + 1)
+    }
+}
 
 /// Adds the `swept` / `exact` step to [`ContinuousStep`].
 #[derive(Clone, Copy, Debug, Default)]
@@ -53,6 +89,8 @@ pub struct ContinuousPlugin;
 impl Plugin for ContinuousPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<EngineState>()
+            .init_resource::<EventBudget>()
+            .register_type::<EventBudget>()
             .init_resource::<Segments>()
             .init_resource::<PairCollisions>()
             .init_resource::<WallCollisions>()
@@ -81,6 +119,7 @@ struct StepSetup<'w> {
     effects: Res<'w, Effects>,
     segments: Res<'w, Segments>,
     dt: Res<'w, StepDt>,
+    budget: Res<'w, EventBudget>,
     stop: Option<Res<'w, StopRequest>>,
 }
 
@@ -133,6 +172,7 @@ fn continuous_step(
         effects,
         segments,
         dt,
+        budget,
         stop,
     } = setup;
     let (own_restitution, filters) = own;
@@ -148,7 +188,7 @@ fn continuous_step(
         &mut circles,
     );
     advance_engine(
-        (*solver, dt.0, stop.as_deref()),
+        (*solver, dt.0, *budget, stop.as_deref()),
         &mut state,
         (&mut counted.pairs, &mut counted.walls),
         messages,
@@ -216,7 +256,7 @@ fn write_back_sleep(state: &EngineState, sleep: &mut Query<&mut Sleep>) -> usize
 /// Processes the step's events (within the solver's budget), counts what they did and, when
 /// recording, writes their hits as messages.
 fn advance_engine(
-    (solver, dt, stop): (Solver, f64, Option<&StopRequest>),
+    (solver, dt, budget, stop): (Solver, f64, EventBudget, Option<&StopRequest>),
     state: &mut EngineState,
     counted: (&mut PairCollisions, &mut WallCollisions),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
@@ -224,11 +264,7 @@ fn advance_engine(
     let Some(engine) = state.engine.as_mut() else {
         return;
     };
-    let per_circle = match solver {
-        Solver::Swept => SWEPT_EVENTS_PER_CIRCLE,
-        _ => EXACT_EVENTS_PER_CIRCLE,
-    };
-    let budget = per_circle * (engine.len() as u64 + 1);
+    let budget = budget.for_step(solver, engine.len());
     let t_start = engine.now();
     let t_end = t_start + dt;
     let stop = || stop.is_some_and(StopRequest::raised);

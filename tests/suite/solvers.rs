@@ -278,3 +278,33 @@ fn solvers_can_be_switched_mid_run() {
     assert_eq!(app.world().resource::<CircleDiagnostics>().non_finite, 0);
     assert_relative("energy across solver switches", e1, e0, 0.05);
 }
+
+#[test]
+fn an_event_budget_bounds_the_work_of_a_step() {
+    for solver in [Solver::Exact, Solver::Swept] {
+        // The default budget is never reached by this gas; with none, every step runs out of it
+        // at its first event (a cell crossing, a hit) and processes no hit.
+        let mut free = gas_1000(solver);
+        step(&mut free, 10);
+        assert_eq!(free.world().resource::<EngineState>().budget_exhausted, 0);
+        assert_eq!(
+            *free.world().resource::<EventBudget>(),
+            EventBudget::default()
+        );
+
+        let mut bounded = gas_1000(solver);
+        *bounded.world_mut().resource_mut::<EventBudget>() = EventBudget { swept: 0, exact: 0 };
+        for k in 1..=10 {
+            let hits = pair_collisions(&bounded) + wall_collisions(&bounded);
+            step(&mut bounded, 1);
+            let done = pair_collisions(&bounded) + wall_collisions(&bounded) - hits;
+            assert_eq!(done, 0, "{solver:?}: hits in a step without budget");
+            let exhausted = bounded.world().resource::<EngineState>().budget_exhausted;
+            assert_eq!(exhausted, k, "{solver:?}: steps over budget");
+        }
+        assert_eq!(
+            bounded.world().resource::<CircleDiagnostics>().non_finite,
+            0
+        );
+    }
+}
