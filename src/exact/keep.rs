@@ -48,10 +48,16 @@ pub struct EngineState {
 
 impl EngineState {
     /// The `exact` engine kept for the next step, as data for a checkpoint (`None` under the
-    /// other solvers, which keep nothing between steps).
+    /// other solvers, which keep nothing between steps). Also `None` while circles meet nothing
+    /// (sensors): its cells are sized without them, and a checkpoint carries no layers, so the
+    /// resumed run builds its engine afresh from the state.
     pub fn snapshot(&self) -> Option<EngineSnapshot> {
         match self.setup {
-            Some((_, _, Solver::Exact)) => self.engine.as_ref().map(EventEngine::snapshot),
+            Some((_, _, Solver::Exact)) => self
+                .engine
+                .as_ref()
+                .filter(|engine| engine.cells_sized_for_all())
+                .map(EventEngine::snapshot),
             _ => None,
         }
     }

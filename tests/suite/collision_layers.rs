@@ -8,9 +8,11 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::arena::{Arena, Boundary};
+use moving_circles::checkpoint::Checkpoint;
 use moving_circles::circle::CircleState;
 use moving_circles::exact::engine::EventEngine;
 use moving_circles::prelude::*;
+use moving_circles::run::Progress;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -534,4 +536,31 @@ fn a_sensor_sweeping_through_a_sleeping_heap_wakes_none_of_it() {
             );
         }
     }
+}
+
+#[test]
+fn a_checkpoint_of_an_exact_run_with_a_wide_sensor_resumes() {
+    // The engine's cells are sized without the sensor, which a checkpoint does not carry: the
+    // checkpoint keeps no engine and the resumed run builds one.
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let mut app = empty_box(Solver::Exact);
+    spawn_bodies(
+        &mut app,
+        &grid_bodies(&mut rng, 48, DVec2::ZERO, |_, _| (None, false)),
+    );
+    let zone = (DVec2::new(0.5, 0.5), DVec2::new(0.2, 0.1), 2.5, None, true);
+    spawn_bodies(&mut app, &[zone]);
+    let progress = Progress::start(app.world_mut());
+    step(&mut app, 20);
+    let bytes = Checkpoint::take(app.world_mut(), "zone", &progress).to_bytes();
+    let checkpoint = Checkpoint::from_bytes(&bytes, "zone.checkpoint")
+        .unwrap_or_else(|e| panic!("our own checkpoint is refused: {e}"));
+    let (mut resumed, _) = checkpoint
+        .resume("zone.checkpoint")
+        .unwrap_or_else(|e| panic!("our own checkpoint does not resume: {e}"));
+    step(&mut resumed, 20);
+    assert_eq!(
+        resumed.world().resource::<CircleDiagnostics>().non_finite,
+        0
+    );
 }

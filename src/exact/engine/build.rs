@@ -30,7 +30,7 @@ impl EventEngine {
         restitution: f64,
         wall_restitution: f64,
     ) -> Self {
-        let width = cell_width(arena, circles);
+        let width = cell_width(arena, circles, &[]);
         Self::with_cells(
             circles,
             arena,
@@ -53,7 +53,7 @@ impl EventEngine {
         rest: &[Rest],
     ) -> Self {
         let mut engine =
-            Self::placed_falling(circles, arena, segments, restitutions, gravity, rest);
+            Self::placed_falling(circles, arena, segments, restitutions, (gravity, rest), &[]);
         engine.predict_all();
         engine
     }
@@ -73,13 +73,16 @@ impl EventEngine {
     ) -> Option<Self> {
         assert!(layers.is_empty() || layers.len() == circles.len());
         let mut engine = match gravity {
-            Some(g) => Self::placed_falling(circles, arena, segments, restitutions, g, rest),
+            Some(g) => {
+                Self::placed_falling(circles, arena, segments, restitutions, (g, rest), &layers)
+            }
             None => Self::placed(
                 circles,
                 arena,
                 segments,
                 restitutions,
-                cell_width(arena, circles),
+                cell_width(arena, circles, &layers),
+                &layers,
             ),
         };
         engine.layers = layers;
@@ -92,11 +95,11 @@ impl EventEngine {
         arena: &Arena,
         segments: &[Segment],
         restitutions: (f64, f64),
-        gravity: DVec2,
-        rest: &[Rest],
+        (gravity, rest): (DVec2, &[Rest]),
+        layers: &[CollisionLayers],
     ) -> Self {
-        let width = cell_width(arena, circles);
-        let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
+        let width = cell_width(arena, circles, layers);
+        let mut engine = Self::lay_out(circles, arena, segments, restitutions, (width, layers));
         engine.gravity = gravity;
         for i in 0..engine.len() {
             let at_rest = rest.get(i).copied().unwrap_or_default();
@@ -119,7 +122,7 @@ impl EventEngine {
         restitutions: (f64, f64),
         width: f64,
     ) -> Self {
-        let mut engine = Self::placed(circles, arena, segments, restitutions, width);
+        let mut engine = Self::placed(circles, arena, segments, restitutions, width, &[]);
         engine.predict_all();
         engine
     }
@@ -131,20 +134,21 @@ impl EventEngine {
         segments: &[Segment],
         restitutions: (f64, f64),
         width: f64,
+        layers: &[CollisionLayers],
     ) -> Self {
-        let mut engine = Self::lay_out(circles, arena, segments, restitutions, width);
+        let mut engine = Self::lay_out(circles, arena, segments, restitutions, (width, layers));
         engine.relink_all();
         engine
     }
 
     /// The engine's state for `circles` at time 0, before any circle is put in a cell or
-    /// predicted.
+    /// predicted, on cells sized for the circles that meet another under `layers`.
     fn lay_out(
         circles: &[CircleState],
         arena: &Arena,
         segments: &[Segment],
         (restitution, wall_restitution): (f64, f64),
-        width: f64,
+        (width, layers): (f64, &[CollisionLayers]),
     ) -> Self {
         let n = circles.len();
         let size = arena.size();
@@ -155,7 +159,7 @@ impl EventEngine {
             large,
             reach,
             images_wrap,
-        } = walls_inside(arena, circles, segments, width);
+        } = walls_inside(arena, circles, segments, width, layers);
         Self {
             arena: *arena,
             period: size,

@@ -22,7 +22,7 @@ impl EventEngine {
                 ..*c
             })
             .collect();
-        let width = cell_width(arena, &grown);
+        let width = cell_width(arena, &grown, &[]);
         let largest = grown.iter().map(|c| c.radius).fold(0.0, f64::max);
         // Cells a largest grown diameter wide hold every circle: none is kept out as large
         // (its reach would be worked out for the radius it starts with).

@@ -4,7 +4,9 @@
 //! block of cells its radius reaches. The cells then stay sized for the many, not the few.
 
 use super::EventEngine;
+use super::walls::sized;
 use crate::circle::CircleState;
+use crate::collision_layers::CollisionLayers;
 use crate::grid::Grid;
 
 /// Most circles kept out of the cells: every prediction looks at all of them, so past a handful
@@ -12,10 +14,16 @@ use crate::grid::Grid;
 pub const MAX_LARGE: usize = 8;
 
 /// The circles to keep out of cells about `width` wide (those wider than it, if at most
-/// [`MAX_LARGE`]), in order, and the largest radius of the circles that stay in the cells.
-pub(super) fn large_circles(circles: &[CircleState], width: f64) -> (Vec<u32>, f64) {
+/// [`MAX_LARGE`]), in order, and the largest radius of the circles that stay in the cells. Only
+/// circles that can meet another under `layers` count ([`sized`]): one that meets none stays in
+/// the cells however wide it is, since no circle ever looks for it there.
+pub(super) fn large_circles(
+    circles: &[CircleState],
+    width: f64,
+    layers: &[CollisionLayers],
+) -> (Vec<u32>, f64) {
     let large: Vec<u32> = (0..circles.len() as u32)
-        .filter(|&i| 2.0 * circles[i as usize].radius > width)
+        .filter(|&i| sized(layers, i as usize) && 2.0 * circles[i as usize].radius > width)
         .collect();
     let large = if large.len() <= MAX_LARGE && large.len() < circles.len() {
         large
@@ -25,7 +33,7 @@ pub(super) fn large_circles(circles: &[CircleState], width: f64) -> (Vec<u32>, f
     let in_cells = circles
         .iter()
         .enumerate()
-        .filter(|(i, _)| !large.contains(&(*i as u32)))
+        .filter(|&(i, _)| sized(layers, i) && !large.contains(&(i as u32)))
         .map(|(_, c)| c.radius)
         .fold(0.0, f64::max);
     (large, in_cells)
@@ -209,6 +217,106 @@ mod tests {
         original.advance_to(3.0, u64::MAX).unwrap();
         restored.advance_to(3.0, u64::MAX).unwrap();
         assert_eq!(restored.snapshot(), original.snapshot());
+    }
+
+    #[test]
+    fn circles_that_meet_none_leave_the_cells_as_they_are_without_them() {
+        // The sand of `boulders_in_sand` without its boulders, and twelve zones of radius 0.15
+        // that meet nothing (sensors): the cells stay sized for the sand, no zone is kept out
+        // of them, and the sand moves bit for bit as it does alone.
+        let sand = boulders_in_sand().split_off(2);
+        let zones = (0..12).map(|k| {
+            let p = DVec2::new(0.15 + 0.07 * k as f64, 0.2 + 0.05 * (k % 5) as f64);
+            CircleState::new(p, DVec2::new(0.1, -0.05), 0.15)
+        });
+        let all: Vec<CircleState> = sand.iter().copied().chain(zones).collect();
+        let layers: Vec<CollisionLayers> = (0..all.len())
+            .map(|i| {
+                if i < sand.len() {
+                    CollisionLayers::DEFAULT
+                } else {
+                    CollisionLayers::NONE
+                }
+            })
+            .collect();
+        for boundary in [Boundary::Walls, Boundary::Periodic] {
+            let arena = Arena::unit_square(boundary);
+            let build = |circles: &[CircleState], layers: Vec<CollisionLayers>| {
+                EventEngine::build_until(
+                    circles,
+                    &arena,
+                    &[],
+                    (1.0, 1.0),
+                    (None, &[]),
+                    layers,
+                    || false,
+                )
+                .unwrap()
+            };
+            let mut alone = build(&sand, Vec::new());
+            let mut beside = build(&all, layers.clone());
+            assert_eq!(beside.grid, alone.grid, "{boundary:?}");
+            assert!(beside.large.is_empty(), "{boundary:?}");
+            // As plain circles the zones widen the cells past twice their radius.
+            let plain = build(&all, Vec::new());
+            assert!(plain.grid.cell.min_element() >= 0.3, "{boundary:?}");
+            alone.advance_to(4.0, u64::MAX).unwrap();
+            beside.advance_to(4.0, u64::MAX).unwrap();
+            assert!(alone.stats().pair_collisions > 200, "{boundary:?}");
+            assert_eq!(
+                alone.stats().pair_collisions,
+                beside.stats().pair_collisions,
+                "{boundary:?}"
+            );
+            for i in 0..sand.len() {
+                assert!(
+                    alone.position(i) == beside.position(i)
+                        && alone.velocity(i) == beside.velocity(i),
+                    "{boundary:?}: circle {i}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_wide_circle_that_comes_to_meet_others_gets_cells_sized_for_it() {
+        // A zone of radius 0.3 built meeting nothing sits in cells sized for the sand; once its
+        // layers let it meet, the cells are laid out again and a grain flying at it bounces off
+        // it instead of passing through.
+        let mut circles = boulders_in_sand().split_off(2);
+        circles.push(CircleState::new(DVec2::new(0.5, 0.5), DVec2::ZERO, 0.3));
+        circles.push(CircleState::new(
+            DVec2::new(0.5, 0.05),
+            DVec2::new(0.0, 1.0),
+            0.004,
+        ));
+        let (zone, grain) = (circles.len() - 2, circles.len() - 1);
+        for c in &mut circles[..zone] {
+            // The sand out of the way: at rest, far from the grain's path.
+            c.velocity = DVec2::ZERO;
+            if (c.position.x - 0.5).abs() < 0.05 || c.position.distance(DVec2::splat(0.5)) < 0.32 {
+                c.position.x = 0.97;
+            }
+        }
+        let arena = Arena::unit_square(Boundary::Walls);
+        let mut layers = vec![CollisionLayers::DEFAULT; circles.len()];
+        layers[zone] = CollisionLayers::NONE;
+        let mut engine = EventEngine::build_until(
+            &circles,
+            &arena,
+            &[],
+            (1.0, 1.0),
+            (None, &[]),
+            layers,
+            || false,
+        )
+        .unwrap();
+        assert!(engine.grid.cell.max_element() < 0.3);
+        engine.set_layers(vec![CollisionLayers::DEFAULT; circles.len()]);
+        engine.advance_to(0.5, u64::MAX).unwrap();
+        // The grain meets the zone's edge at y = 0.196 (t ≈ 0.146) and flies back down.
+        assert!(engine.velocity(grain).y < 0.0, "{}", engine.velocity(grain));
+        assert!(engine.position(grain).distance(engine.position(zone)) >= 0.304 - 1e-12);
     }
 
     #[test]

@@ -38,12 +38,13 @@ pub use snapshot::EngineSnapshot;
 pub use spin::Roughness;
 
 use events::{BestPair, Event, Kind, Motion};
-use walls::{Layout, cell_width, walls_inside};
+use walls::{Layout, cell_width, sized, walls_inside};
 
 use bevy::math::DVec2;
 
 use super::queue::EventQueue;
 use crate::arena::Arena;
+use crate::circle::CircleState;
 use crate::collision_layers::{CollisionLayers, pair_meets};
 use crate::grid::{CellMembers, Grid};
 use crate::hits::HitLog;
@@ -140,8 +141,50 @@ impl EventEngine {
     /// engine with layers from the start, see [`EventEngine::build_until`].
     pub fn set_layers(&mut self, layers: Vec<CollisionLayers>) {
         assert!(layers.is_empty() || layers.len() == self.len());
+        let resized = (0..self.len()).any(|i| sized(&self.layers, i) != sized(&layers, i));
         self.layers = layers;
+        // The cells are sized for the circles that meet another: a circle left out of the
+        // sizing (a sensor, however wide) that now meets one needs cells sized for it. A
+        // growing engine's cells are sized for every circle already.
+        if resized && self.growth == 0.0 {
+            self.lay_out_cells();
+        }
         self.predict_all();
+    }
+
+    /// Lays the cells out again for the circles as they are now (same trajectories: the cells
+    /// are bookkeeping), each listed in the cell it is in now.
+    fn lay_out_cells(&mut self) {
+        let circles: Vec<CircleState> = self
+            .motion
+            .iter()
+            .map(|m| CircleState::new(m.pos, m.vel, m.radius))
+            .collect();
+        let width = cell_width(&self.arena, &circles, &self.layers);
+        let Layout {
+            grid,
+            segment_cells,
+            large,
+            reach,
+            images_wrap,
+            ..
+        } = walls_inside(&self.arena, &circles, &self.segments, width, &self.layers);
+        (self.grid, self.segment_cells) = (grid, segment_cells);
+        (self.large, self.reach, self.images_wrap) = (large, reach, images_wrap);
+        self.cells = CellMembers::new(grid.len(), self.len());
+        for i in 0..self.len() {
+            let (x, y) = self.grid.cell_of(self.inside(self.pos_at(i, self.now)));
+            (self.cell_x[i], self.cell_y[i]) = (x as u32, y as u32);
+            if self.large_reach(i).is_none() {
+                self.cells.insert(i, self.grid.index(x, y));
+            }
+        }
+    }
+
+    /// Whether the cells are sized for every circle: none meets nothing under the engine's
+    /// layers (a sensor does, and is left out of the sizing).
+    pub fn cells_sized_for_all(&self) -> bool {
+        (0..self.len()).all(|i| sized(&self.layers, i))
     }
 
     /// Circle `i`'s layers ([`CollisionLayers::DEFAULT`] when the engine has none).

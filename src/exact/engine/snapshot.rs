@@ -97,7 +97,7 @@ impl EventEngine {
             return Err(format!("engine clock {} is not finite", s.now));
         }
         let size = arena.size();
-        let width = cell_width(arena, circles);
+        let width = cell_width(arena, circles, &[]);
         let Layout {
             grid,
             segments,
@@ -105,7 +105,7 @@ impl EventEngine {
             large,
             reach,
             images_wrap,
-        } = walls_inside(arena, circles, segments, width);
+        } = walls_inside(arena, circles, segments, width, &[]);
         let partner_ok = |p: u32, i: usize| p == NONE || (p as usize) < n && p as usize != i;
         for (i, c) in circles.iter().enumerate() {
             let m = &s.motion[i];

@@ -8,6 +8,7 @@ use crate::arena::Arena;
 use crate::boundary::put_back_inside;
 use crate::circle::CircleState;
 use crate::collide::contact::combine_restitution;
+use crate::collision_layers::{CollisionLayers, meets_any};
 use crate::grid::Grid;
 use crate::hits::{ArenaWall, Wall, WallHit};
 use crate::segment::{Segment, SegmentCells};
@@ -149,6 +150,13 @@ pub(super) struct Layout {
     pub(super) images_wrap: bool,
 }
 
+/// Whether the cells are sized for circle `i` under `layers` (none: every circle): only if it can
+/// meet another. A sensor meets none, so nothing ever looks for it in the cells.
+#[inline]
+pub(super) fn sized(layers: &[CollisionLayers], i: usize) -> bool {
+    layers.is_empty() || meets_any(layers[i])
+}
+
 /// The engine's [`Layout`]: cells at least `width` wide, and one diameter of every circle in
 /// them (all but a few [`large_circles`] far wider than `width`), about four per circle or
 /// segment at most; segment walls listed in the cells they pass within a largest radius of.
@@ -157,6 +165,7 @@ pub(super) fn walls_inside(
     circles: &[CircleState],
     segments: &[Segment],
     width: f64,
+    layers: &[CollisionLayers],
 ) -> Layout {
     let segments = if arena.is_periodic() {
         &[][..]
@@ -164,7 +173,7 @@ pub(super) fn walls_inside(
         segments
     };
     let largest = circles.iter().map(|c| c.radius).fold(0.0f64, f64::max);
-    let (large, in_cells) = large_circles(circles, width);
+    let (large, in_cells) = large_circles(circles, width, layers);
     let cap = circles.len() + segments.len();
     let grid = Grid::tiling(
         arena.min,
@@ -215,14 +224,24 @@ const COLLISION_WEIGHT: f64 = 60.0;
 /// diameter `d` and `g` Henderson's contact value. With `L = u·s`, `s = 1/√ρ` the mean spacing,
 /// the cost is least where `CROSSING_COST / u² = 3 + COLLISION_WEIGHT · g · (d/s) · u`, solved
 /// here by bisection. Dense gases get cells about a diameter wide; dilute ones, cells a few
-/// spacings wide, so that a circle crosses fewer of them between collisions.
-pub(super) fn cell_width(arena: &Arena, circles: &[CircleState]) -> f64 {
-    let n = circles.len().max(1) as f64;
+/// spacings wide, so that a circle crosses fewer of them between collisions. Only the circles
+/// the cells are [`sized`] for under `layers` count.
+pub(super) fn cell_width(
+    arena: &Arena,
+    circles: &[CircleState],
+    layers: &[CollisionLayers],
+) -> f64 {
+    let radii = || {
+        (0..circles.len())
+            .filter(|&i| sized(layers, i))
+            .map(|i| circles[i].radius)
+    };
+    let n = radii().count().max(1) as f64;
     let size = arena.size();
     let area = size.x * size.y;
     let spacing = (area / n).sqrt();
-    let diameter = 2.0 * circles.iter().map(|c| c.radius).sum::<f64>() / n;
-    let fraction = arena.area_fraction(circles.iter().map(|c| c.radius));
+    let diameter = 2.0 * radii().sum::<f64>() / n;
+    let fraction = arena.area_fraction(radii());
     let phi = fraction.min(0.8);
     let contact = (1.0 - 7.0 * phi / 16.0) / ((1.0 - phi) * (1.0 - phi));
     let collisions = COLLISION_WEIGHT * contact * diameter / spacing;
@@ -301,10 +320,10 @@ mod tests {
     fn dense_gases_get_cells_a_diameter_wide_dilute_ones_wider() {
         let arena = Arena::unit_square(Boundary::Periodic);
         let dense = gas(2500, 0.009, &arena); // area fraction 0.64
-        assert!(cell_width(&arena, &dense) < 2.0 * 0.009);
+        assert!(cell_width(&arena, &dense, &[]) < 2.0 * 0.009);
         let dilute = gas(2000, 0.001, &arena); // 0.006, like p2000.txt
         let spacing = (1.0f64 / 2000.0).sqrt();
-        let width = cell_width(&arena, &dilute);
+        let width = cell_width(&arena, &dilute, &[]);
         assert!((1.2 * spacing..2.0 * spacing).contains(&width), "{width}");
     }
 
