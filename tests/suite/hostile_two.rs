@@ -287,3 +287,26 @@ fn a_checkpoint_that_cannot_be_written_ends_the_run_with_the_other_outputs_writt
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_circle_too_fast_for_the_clock_never_falls_asleep_outside_the_walls() {
+    // Found by the checkpoint fuzz target: a heap under `swept` in which one circle flies at
+    // 8.8e28 m/s. Its hits pass that speed on, and a circle crossing metres in the clock's
+    // last tick fell asleep (jammed by quick hits) with its centre 0.7 m past the top wall,
+    // where sleep kept it: step 2 of the resumed run ended with a circle outside.
+    let dir = temp_dir("too-fast");
+    let report = dir.join("r.json");
+    let out = crate::common::binary::moving_circles(&[
+        "run",
+        "--resume",
+        "tests/data/checkpoints/too_fast_to_resolve.checkpoint",
+        "--steps",
+        "4",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report = std::fs::read_to_string(&report).unwrap();
+    assert!(report.contains("\"escaped\": 0"), "{report}");
+    assert!(report.contains("\"non_finite\": 0"), "{report}");
+}

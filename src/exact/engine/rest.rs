@@ -26,6 +26,7 @@
 use bevy::math::DVec2;
 
 use super::EventEngine;
+use crate::boundary::put_back_inside;
 
 /// A bounce that would lift a circle less than this many of its radii is rest.
 pub const REST_HEIGHT: f64 = 1e-3;
@@ -75,13 +76,20 @@ impl EventEngine {
         }
     }
 
-    /// Circle `i` sleeps from now: at rest where it is.
+    /// Circle `i` sleeps from now: at rest where it is. A centre the clock's rounding left past
+    /// an arena wall (a circle too fast for the clock to resolve, crossing metres in its last
+    /// tick) is put back inside, as the wall hit that sleeping cancels would have put it.
     fn fall_asleep(&mut self, i: usize) {
         self.asleep[i] = true;
         self.falls[i] = false;
         self.quick_hits[i] = 0;
         self.motion[i].vel = DVec2::ZERO;
         self.stop_turning(i);
+        let m = &mut self.motion[i];
+        if self.arena.has_walls() && !self.arena.contains(m.pos) {
+            put_back_inside(&mut m.pos, m.radius, &self.arena);
+            self.relist(i);
+        }
     }
 
     /// Whether circle `i` flies a parabola: movable, awake, under gravity.
