@@ -233,10 +233,16 @@ impl Checkpoint {
             check_spin(c)
                 .map_err(|e| e.within(&format!("circles[{i}]")))
                 .map_err(describe)?;
-            // A circle asleep does not turn (it would drive its neighbours like a wheel).
+            // A circle asleep is at rest: every solver that puts one to sleep stops it, and one
+            // that moved or turned would drive its neighbours (a turning one like a wheel)
+            // while no solver steps it; without gravity `swept` and `exact` would fly it and
+            // leave it marked asleep.
             let w = c.angular_velocity;
             if self.sleep[i].asleep && w != 0.0 {
                 return Err(format!("circle {i} is asleep but turns at {w:?}"));
+            }
+            if self.sleep[i].asleep && c.velocity != bevy::math::DVec2::ZERO {
+                return Err(format!("circle {i} is asleep but moves at {}", c.velocity));
             }
             // Every step ends with each centre inside (put back or wrapped): one outside means
             // the circle or the arena was changed. An open arena lets circles go anywhere.
@@ -401,6 +407,15 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("asleep but turns"), "{error}");
+        // So would a sleeper that moves (found by the checkpoint fuzz target: under `exact`
+        // without gravity it flew on, marked asleep, and was given a spin by a rough hit).
+        let mut moving = good.clone();
+        moving.sleep[2].asleep = true;
+        moving.circles[2].velocity = DVec2::new(-1.6, -1.3);
+        let error = Checkpoint::from_bytes(&moving.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("asleep but moves"), "{error}");
         let mut spun = good.clone();
         spun.circles[2].rotation = 4.0;
         let error = Checkpoint::from_bytes(&spun.to_bytes(), "c")
