@@ -194,7 +194,7 @@ fn continuous_step(
         messages,
     );
     write_back(&mut state, &mut circles.p0());
-    counted.sleeping.count = write_back_sleep(&state, &mut circles.p2());
+    counted.sleeping.count = write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count);
     if !write_back_turning(&state, &mut circles.p3()) {
         turn_circles(&mut circles.p3(), dt.0); // smooth circles trade no spin
     }
@@ -226,13 +226,23 @@ fn write_back_turning(state: &EngineState, spins: &mut SpinCircles) -> bool {
 
 /// Writes each circle's rest back to its [`Sleep`] (in the engine's order), for the next engine
 /// `swept` builds and for checkpoints, and returns how many circles sleep. Only under gravity:
-/// without it nothing rests.
-fn write_back_sleep(state: &EngineState, sleep: &mut Query<&mut Sleep>) -> usize {
+/// without it nothing rests, and circles still marked asleep (`asleep_before` of them, from a
+/// checkpoint) fly like the others, so they are marked awake.
+fn write_back_sleep(
+    state: &EngineState,
+    sleep: &mut Query<&mut Sleep>,
+    asleep_before: usize,
+) -> usize {
     let Some(engine) = state.engine.as_ref() else {
         return 0;
     };
     let falling = matches!(state.setup, Some((_, effects, _)) if effects.gravity.is_some());
     if !falling {
+        if asleep_before > 0 {
+            for mut s in sleep.iter_mut().filter(|s| s.asleep) {
+                *s = Sleep::default();
+            }
+        }
         return 0;
     }
     let mut asleep = 0;

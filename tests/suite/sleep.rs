@@ -1,6 +1,7 @@
 //! Sleeping under the time-stepped solvers: a heap at rest falls asleep and stays exactly where
 //! it is, a ball dropped onto it wakes it and it sleeps again, your code's writes wake a
-//! sleeping circle, a change of the effects wakes them all, and nothing sleeps without gravity.
+//! sleeping circle, a change of the effects wakes them all, and nothing sleeps without gravity
+//! (a circle a checkpoint marks asleep is awake under `exact` and `swept` without it).
 
 use crate::common::*;
 use bevy::math::DVec2;
@@ -173,4 +174,57 @@ fn nothing_sleeps_without_gravity_and_sleeping_can_be_switched_off() {
     let mut app = heap("soft");
     app.world_mut().resource_mut::<Effects>().sleep.enabled = false;
     assert!(until_asleep(&mut app, 5.0).is_none());
+}
+
+#[test]
+fn a_checkpoint_marking_a_circle_asleep_resumes_under_exact_without_gravity_to_a_readable_one() {
+    use moving_circles::checkpoint::Checkpoint;
+    use moving_circles::components::Sleep;
+    use moving_circles::run::Progress;
+    // A circle at rest marked asleep in a checkpoint of an `exact` run without gravity (where
+    // nothing rests) and one flying at it. The engine flies it like any circle: once hit it
+    // moved on still marked asleep, and the checkpoint of where the run ended was refused by
+    // our own reader ("asleep but moves"). Reviewing the rule that refuses that found this.
+    for solver in [Solver::Exact, Solver::Swept] {
+        let config = CirclesConfig {
+            arena: Arena::centered(DVec2::new(4.0, 2.0)),
+            solver,
+            spawn: SpawnConfig {
+                count: 0,
+                ..default()
+            },
+            ..default()
+        };
+        let mut app = create_app(config);
+        let still = spawn_circle(&mut app, DVec2::new(1.0, 0.0), DVec2::ZERO, 0.2, 1.0);
+        spawn_circle(
+            &mut app,
+            DVec2::new(-1.0, 0.0),
+            DVec2::new(2.0, 0.0),
+            0.2,
+            1.0,
+        );
+        app.world_mut().entity_mut(still).insert(Sleep {
+            asleep: true,
+            ..default()
+        });
+        let progress = Progress::start(app.world_mut());
+        let bytes = Checkpoint::take(app.world_mut(), "asleep", &progress).to_bytes();
+        let (mut resumed, progress) = Checkpoint::from_bytes(&bytes, "asleep.checkpoint")
+            .and_then(|c| c.resume("asleep.checkpoint"))
+            .unwrap();
+        step(&mut resumed, 60); // the hit comes at 0.8 s
+        let world = resumed.world_mut();
+        let moving = world
+            .query::<(&Velocity, &Sleep)>()
+            .iter(world)
+            .filter(|(v, _)| v.0 != DVec2::ZERO)
+            .count();
+        assert_eq!(moving, 1, "{solver}: the hit passes the motion on");
+        assert!(world.query::<&Sleep>().iter(world).all(|s| !s.asleep));
+        let end = Checkpoint::take(world, "asleep", &progress).to_bytes();
+        if let Err(error) = Checkpoint::from_bytes(&end, "end.checkpoint") {
+            panic!("{solver}: our own checkpoint is refused: {error}");
+        }
+    }
 }
