@@ -233,16 +233,16 @@ impl Checkpoint {
             check_spin(c)
                 .map_err(|e| e.within(&format!("circles[{i}]")))
                 .map_err(describe)?;
-            // A circle asleep is at rest: every solver that puts one to sleep stops it, and one
-            // that moved or turned would drive its neighbours (a turning one like a wheel)
-            // while no solver steps it; without gravity `swept` and `exact` would fly it and
-            // leave it marked asleep.
-            let w = c.angular_velocity;
-            if self.sleep[i].asleep && w != 0.0 {
-                return Err(format!("circle {i} is asleep but turns at {w:?}"));
-            }
-            if self.sleep[i].asleep && c.velocity != bevy::math::DVec2::ZERO {
-                return Err(format!("circle {i} is asleep but moves at {}", c.velocity));
+            // A circle asleep is at rest (every solver stops one it puts to sleep): one moving
+            // or turning would drive its neighbours, a turning one like a wheel.
+            let (v, w) = (c.velocity, c.angular_velocity);
+            if self.sleep[i].asleep && (w != 0.0 || v != bevy::math::DVec2::ZERO) {
+                let how = if w != 0.0 {
+                    format!("turns at {w:?}")
+                } else {
+                    format!("moves at {v}")
+                };
+                return Err(format!("circle {i} is asleep but {how}"));
             }
             // Every step ends with each centre inside (put back or wrapped): one outside means
             // the circle or the arena was changed. An open arena lets circles go anywhere.
@@ -399,23 +399,18 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("impossible radius"), "{error}");
-        // A sleeper that turns would drive its neighbours like a wheel.
-        let mut turning = good.clone();
-        turning.sleep[2].asleep = true;
-        turning.circles[2].angular_velocity = 3.0;
-        let error = Checkpoint::from_bytes(&turning.to_bytes(), "c")
-            .unwrap_err()
-            .to_string();
-        assert!(error.contains("asleep but turns"), "{error}");
-        // So would a sleeper that moves (found by the checkpoint fuzz target: under `exact`
-        // without gravity it flew on, marked asleep, and was given a spin by a rough hit).
-        let mut moving = good.clone();
-        moving.sleep[2].asleep = true;
-        moving.circles[2].velocity = DVec2::new(-1.6, -1.3);
-        let error = Checkpoint::from_bytes(&moving.to_bytes(), "c")
-            .unwrap_err()
-            .to_string();
-        assert!(error.contains("asleep but moves"), "{error}");
+        // A sleeper that turns would drive its neighbours like a wheel, and one that moves too
+        // (found by the checkpoint fuzz target: without gravity `exact` flew it on, asleep).
+        for (w, v, says) in [
+            (3.0, 0.0, "asleep but turns"),
+            (0.0, -1.6, "asleep but moves"),
+        ] {
+            let mut woken = good.clone();
+            woken.sleep[2].asleep = true;
+            (woken.circles[2].angular_velocity, woken.circles[2].velocity) = (w, DVec2::X * v);
+            let error = Checkpoint::from_bytes(&woken.to_bytes(), "c").unwrap_err();
+            assert!(error.to_string().contains(says), "{error}");
+        }
         let mut spun = good.clone();
         spun.circles[2].rotation = 4.0;
         let error = Checkpoint::from_bytes(&spun.to_bytes(), "c")

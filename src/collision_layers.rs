@@ -201,6 +201,13 @@ pub fn meets_any(layers: CollisionLayers) -> bool {
     layers.memberships != 0 && layers.filters != 0
 }
 
+/// Whether circle `i` can meet any circle, given each circle's layers (`layers` empty: every
+/// circle can): the circles the event engine sizes its cells for.
+#[inline]
+pub fn can_meet(layers: &[CollisionLayers], i: usize) -> bool {
+    layers.is_empty() || meets_any(layers[i])
+}
+
 /// Whether circles `i` and `j` meet, given each circle's layers (`layers` empty: all meet, as
 /// circles without layers do).
 #[inline]

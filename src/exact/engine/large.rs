@@ -4,9 +4,8 @@
 //! block of cells its radius reaches. The cells then stay sized for the many, not the few.
 
 use super::EventEngine;
-use super::walls::sized;
 use crate::circle::CircleState;
-use crate::collision_layers::CollisionLayers;
+use crate::collision_layers::{CollisionLayers, can_meet};
 use crate::grid::Grid;
 
 /// Most circles kept out of the cells: every prediction looks at all of them, so past a handful
@@ -15,7 +14,7 @@ pub const MAX_LARGE: usize = 8;
 
 /// The circles to keep out of cells about `width` wide (those wider than it, if at most
 /// [`MAX_LARGE`]), in order, and the largest radius of the circles that stay in the cells. Only
-/// circles that can meet another under `layers` count ([`sized`]): one that meets none stays in
+/// circles that [`can_meet`] another under `layers` count: one that meets none stays in
 /// the cells however wide it is, since no circle ever looks for it there.
 pub(super) fn large_circles(
     circles: &[CircleState],
@@ -23,7 +22,7 @@ pub(super) fn large_circles(
     layers: &[CollisionLayers],
 ) -> (Vec<u32>, f64) {
     let large: Vec<u32> = (0..circles.len() as u32)
-        .filter(|&i| sized(layers, i as usize) && 2.0 * circles[i as usize].radius > width)
+        .filter(|&i| can_meet(layers, i as usize) && 2.0 * circles[i as usize].radius > width)
         .collect();
     let large = if large.len() <= MAX_LARGE && large.len() < circles.len() {
         large
@@ -33,7 +32,7 @@ pub(super) fn large_circles(
     let in_cells = circles
         .iter()
         .enumerate()
-        .filter(|&(i, _)| sized(layers, i) && !large.contains(&(i as u32)))
+        .filter(|&(i, _)| can_meet(layers, i) && !large.contains(&(i as u32)))
         .map(|(_, c)| c.radius)
         .fold(0.0, f64::max);
     (large, in_cells)

@@ -38,14 +38,14 @@ pub use snapshot::EngineSnapshot;
 pub use spin::Roughness;
 
 use events::{BestPair, Event, Kind, Motion};
-use walls::{Layout, cell_width, sized, walls_inside};
+use walls::{Layout, cell_width, walls_inside};
 
 use bevy::math::DVec2;
 
 use super::queue::EventQueue;
 use crate::arena::Arena;
 use crate::circle::CircleState;
-use crate::collision_layers::{CollisionLayers, pair_meets};
+use crate::collision_layers::{CollisionLayers, can_meet, pair_meets};
 use crate::grid::{CellMembers, Grid};
 use crate::hits::HitLog;
 use crate::segment::{Segment, SegmentCells};
@@ -141,7 +141,7 @@ impl EventEngine {
     /// engine with layers from the start, see [`EventEngine::build_until`].
     pub fn set_layers(&mut self, layers: Vec<CollisionLayers>) {
         assert!(layers.is_empty() || layers.len() == self.len());
-        let resized = (0..self.len()).any(|i| sized(&self.layers, i) != sized(&layers, i));
+        let resized = (0..self.len()).any(|i| can_meet(&self.layers, i) != can_meet(&layers, i));
         self.layers = layers;
         // The cells are sized for the circles that meet another: a circle left out of the
         // sizing (a sensor, however wide) that now meets one needs cells sized for it. A
@@ -184,7 +184,7 @@ impl EventEngine {
     /// Whether the cells are sized for every circle: none meets nothing under the engine's
     /// layers (a sensor does, and is left out of the sizing).
     pub fn cells_sized_for_all(&self) -> bool {
-        (0..self.len()).all(|i| sized(&self.layers, i))
+        (0..self.len()).all(|i| can_meet(&self.layers, i))
     }
 
     /// Circle `i`'s layers ([`CollisionLayers::DEFAULT`] when the engine has none).

@@ -8,7 +8,7 @@ use crate::arena::Arena;
 use crate::boundary::put_back_inside;
 use crate::circle::CircleState;
 use crate::collide::contact::combine_restitution;
-use crate::collision_layers::{CollisionLayers, meets_any};
+use crate::collision_layers::{CollisionLayers, can_meet};
 use crate::grid::Grid;
 use crate::hits::{ArenaWall, Wall, WallHit};
 use crate::segment::{Segment, SegmentCells};
@@ -150,13 +150,6 @@ pub(super) struct Layout {
     pub(super) images_wrap: bool,
 }
 
-/// Whether the cells are sized for circle `i` under `layers` (none: every circle): only if it can
-/// meet another. A sensor meets none, so nothing ever looks for it in the cells.
-#[inline]
-pub(super) fn sized(layers: &[CollisionLayers], i: usize) -> bool {
-    layers.is_empty() || meets_any(layers[i])
-}
-
 /// The engine's [`Layout`]: cells at least `width` wide, and one diameter of every circle in
 /// them (all but a few [`large_circles`] far wider than `width`), about four per circle or
 /// segment at most; segment walls listed in the cells they pass within a largest radius of.
@@ -225,7 +218,8 @@ const COLLISION_WEIGHT: f64 = 60.0;
 /// the cost is least where `CROSSING_COST / u² = 3 + COLLISION_WEIGHT · g · (d/s) · u`, solved
 /// here by bisection. Dense gases get cells about a diameter wide; dilute ones, cells a few
 /// spacings wide, so that a circle crosses fewer of them between collisions. Only the circles
-/// the cells are [`sized`] for under `layers` count.
+/// that [`can_meet`] another under `layers` count: a sensor meets none, so nothing ever looks
+/// for it in the cells.
 pub(super) fn cell_width(
     arena: &Arena,
     circles: &[CircleState],
@@ -233,7 +227,7 @@ pub(super) fn cell_width(
 ) -> f64 {
     let radii = || {
         (0..circles.len())
-            .filter(|&i| sized(layers, i))
+            .filter(|&i| can_meet(layers, i))
             .map(|i| circles[i].radius)
     };
     let n = radii().count().max(1) as f64;
