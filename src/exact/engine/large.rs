@@ -218,6 +218,18 @@ mod tests {
         assert_eq!(restored.snapshot(), original.snapshot());
     }
 
+    /// An elastic engine of `circles` without gravity, with their `layers`.
+    fn elastic(
+        circles: &[CircleState],
+        arena: &Arena,
+        layers: Vec<CollisionLayers>,
+    ) -> EventEngine {
+        EventEngine::build_until(circles, arena, &[], (1.0, 1.0), (None, &[]), layers, || {
+            false
+        })
+        .unwrap()
+    }
+
     #[test]
     fn circles_that_meet_none_leave_the_cells_as_they_are_without_them() {
         // The sand of `boulders_in_sand` without its boulders, and twelve zones of radius 0.15
@@ -240,18 +252,7 @@ mod tests {
             .collect();
         for boundary in [Boundary::Walls, Boundary::Periodic] {
             let arena = Arena::unit_square(boundary);
-            let build = |circles: &[CircleState], layers: Vec<CollisionLayers>| {
-                EventEngine::build_until(
-                    circles,
-                    &arena,
-                    &[],
-                    (1.0, 1.0),
-                    (None, &[]),
-                    layers,
-                    || false,
-                )
-                .unwrap()
-            };
+            let build = |circles: &[CircleState], layers| elastic(circles, &arena, layers);
             let mut alone = build(&sand, Vec::new());
             let mut beside = build(&all, layers.clone());
             assert_eq!(beside.grid, alone.grid, "{boundary:?}");
@@ -300,16 +301,7 @@ mod tests {
         let arena = Arena::unit_square(Boundary::Walls);
         let mut layers = vec![CollisionLayers::DEFAULT; circles.len()];
         layers[zone] = CollisionLayers::NONE;
-        let mut engine = EventEngine::build_until(
-            &circles,
-            &arena,
-            &[],
-            (1.0, 1.0),
-            (None, &[]),
-            layers,
-            || false,
-        )
-        .unwrap();
+        let mut engine = elastic(&circles, &arena, layers);
         assert!(engine.grid.cell.max_element() < 0.3);
         engine.set_layers(vec![CollisionLayers::DEFAULT; circles.len()]);
         engine.advance_to(0.5, u64::MAX).unwrap();
