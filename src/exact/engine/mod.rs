@@ -172,13 +172,7 @@ impl EventEngine {
         (self.grid, self.segment_cells) = (grid, segment_cells);
         (self.large, self.reach, self.images_wrap) = (large, reach, images_wrap);
         self.cells = CellMembers::new(grid.len(), self.len());
-        for i in 0..self.len() {
-            let (x, y) = self.grid.cell_of(self.inside(self.pos_at(i, self.now)));
-            (self.cell_x[i], self.cell_y[i]) = (x as u32, y as u32);
-            if self.large_reach(i).is_none() {
-                self.cells.insert(i, self.grid.index(x, y));
-            }
-        }
+        self.relink_all();
     }
 
     /// Whether the cells are sized for every circle: none meets nothing under the engine's
@@ -339,12 +333,13 @@ impl EventEngine {
             .index(self.cell_x[i] as usize, self.cell_y[i] as usize)
     }
 
-    /// Puts every circle in the cell its current position lies in (large circles in none, but
-    /// each still knows its cell).
+    /// Puts every circle in the cell its position now lies in (large circles in none, but each
+    /// still knows its cell). Where every reference time is now (a build, a drift) that is the
+    /// reference point itself.
     fn relink_all(&mut self) {
         self.cells.clear();
         for i in 0..self.len() {
-            let (x, y) = self.grid.cell_of(self.motion[i].pos);
+            let (x, y) = self.grid.cell_of(self.inside(self.pos_at(i, self.now)));
             self.cell_x[i] = x as u32;
             self.cell_y[i] = y as u32;
             if self.large_reach(i).is_none() {
