@@ -47,19 +47,66 @@ pub struct EngineState {
 }
 
 impl EngineState {
-    /// The `exact` engine kept for the next step, as data for a checkpoint (`None` under the
-    /// other solvers, which keep nothing between steps). Also `None` while circles meet nothing
-    /// (sensors): its cells are sized without them, and a checkpoint carries no layers, so the
-    /// resumed run builds its engine afresh from the state.
-    pub fn snapshot(&self) -> Option<EngineSnapshot> {
-        match self.setup {
-            Some((_, _, Solver::Exact)) => self
-                .engine
-                .as_ref()
-                .filter(|engine| engine.cells_sized_for_all())
-                .map(EventEngine::snapshot),
-            _ => None,
+    /// The `exact` engine kept for the next step, as data for a checkpoint of `circles` (the
+    /// world's now, with their entities in the order of the step's query) under `setup` (the
+    /// world's arena, effects and solver) and `segments`. What user code wrote to the circles
+    /// since the last step is applied as that step's gather would apply it, so the checkpoint's
+    /// engine and circles agree. `None` under the other solvers, which keep nothing between
+    /// steps; where the next step would build a fresh engine (the setup or the segment walls
+    /// changed, circles came, went or changed their radius or mass, or more than one in
+    /// [`MOVED_FOR_REBUILD`] was moved); and while circles meet nothing (sensors): its cells
+    /// are sized without them, and a checkpoint carries no layers. The resumed run then builds
+    /// its engine afresh from the state, as the next step would.
+    pub fn snapshot(
+        &self,
+        setup: (Arena, Effects, Solver),
+        segments: &Segments,
+        circles: &[(Entity, CircleState)],
+    ) -> Option<EngineSnapshot> {
+        let engine = self.engine.as_ref()?;
+        let kept = self.setup == Some(setup)
+            && setup.2 == Solver::Exact
+            && self.segments == *segments
+            && !self.reordered
+            && engine.cells_sized_for_all()
+            && circles.len() == self.entities.len()
+            && circles.iter().zip(&self.entities).all(|((e, _), k)| e == k);
+        if !kept {
+            return None;
         }
+        let mut moved = Vec::new();
+        for (i, (_, c)) in circles.iter().enumerate() {
+            let (radius, inv_mass, _) = engine.body(i);
+            if (radius, inv_mass) != (c.radius, c.inv_mass()) {
+                return None;
+            }
+            let motion = (c.position, c.velocity) != (engine.position(i), engine.velocity(i));
+            let turn = (c.angular_velocity, c.rotation);
+            let turned = engine.turn(i).is_some_and(|t| t != turn);
+            if motion || turned {
+                moved.push((
+                    i,
+                    motion.then_some((c.position, c.velocity)),
+                    turned.then_some(turn),
+                ));
+            }
+        }
+        if moved.is_empty() {
+            return Some(engine.snapshot());
+        }
+        if moved.len() > circles.len() / MOVED_FOR_REBUILD {
+            return None;
+        }
+        let mut engine = engine.clone();
+        for (i, motion, turn) in moved {
+            if let Some((position, velocity)) = motion {
+                engine.set_motion(i, position, velocity);
+            }
+            if let Some((spin, angle)) = turn {
+                engine.set_turn(i, spin, angle);
+            }
+        }
+        Some(engine.snapshot())
     }
 
     /// Puts back the `exact` engine of a checkpoint for `circles` (entities in the order of the
@@ -235,15 +282,30 @@ pub(super) fn gather_into_engine(
         .iter()
         .map(|(_, p, v, r, m, ..)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
         .collect();
-    let rest: Vec<Rest> = all
+    // A sleeper your code set moving or turning since the last step wakes, as under the
+    // time-stepped solvers (built asleep, it would lose the velocity).
+    let rest_of = |sleep: &Sleep, moving: bool| match sleep.asleep && moving {
+        true => Rest::default(),
+        false => Rest {
+            asleep: sleep.asleep,
+            anchor: sleep.anchor,
+            resting_for: sleep.slow_for,
+        },
+    };
+    let mut rest: Vec<Rest> = all
         .iter()
-        .map(|c| Rest {
-            asleep: c.6.asleep,
-            anchor: c.6.anchor,
-            resting_for: c.6.slow_for,
-        })
+        .map(|c| rest_of(c.6, c.2.0 != DVec2::ZERO))
         .collect();
     let entities: Vec<Entity> = all.iter().map(|(e, ..)| e).collect();
+    let spins = circles.p3();
+    for (r, &e) in rest.iter_mut().zip(&entities).filter(|(r, _)| r.asleep) {
+        if let Ok((Some(spin), ..)) = spins.get(e)
+            && spin.0 != 0.0
+        {
+            *r = Rest::default();
+        }
+    }
+    let all = circles.p0();
     let layers = own.filters.gather(entities.iter().copied());
     let restitutions = (effects.restitution, effects.wall_restitution);
     let stopped = || stop.is_some_and(StopRequest::raised);

@@ -1,7 +1,8 @@
 //! Settings changed by a game's own system while the simulation runs take effect at the next
 //! step, under every solver: the effects (gravity on and off), the arena (walls to periodic),
 //! the segment walls (one put in a circle's path) and the solver (a fast pair that only the
-//! continuous solvers catch).
+//! continuous solvers catch). A checkpoint taken right after such a change, before the step
+//! that applies it, resumes as the run goes on.
 
 use crate::common::*;
 use bevy::math::DVec2;
@@ -138,6 +139,60 @@ fn a_solver_switched_by_a_system_steps_from_then_on() {
             let hits = app.world().resource::<PairCollisions>().count;
             let expected = u64::from(to == Solver::Exact);
             assert_eq!(hits, expected, "{from} switched to {to} after one step");
+        }
+    }
+}
+
+#[test]
+fn a_checkpoint_taken_right_after_a_games_changes_resumes_as_the_run_goes_on() {
+    use moving_circles::checkpoint::Checkpoint;
+    use moving_circles::circle::snapshot;
+    use moving_circles::run::Progress;
+    // What a game may do between two steps: steer a few circles (`exact` updates its kept
+    // engine), steer them all (it builds afresh), switch gravity on. A checkpoint of the state
+    // then must be read back by our own reader and go on as the run does; under `exact` its
+    // engine must agree with its circles (it refused them all before).
+    let changes: [Named<fn(&mut World)>; 3] = [
+        ("one steered", |world| {
+            let mut velocities = world.query::<&mut Velocity>();
+            velocities
+                .iter_mut(world)
+                .step_by(8)
+                .for_each(|mut v| v.0 = -v.0);
+        }),
+        ("all steered", |world| {
+            let mut velocities = world.query::<&mut Velocity>();
+            velocities.iter_mut(world).for_each(|mut v| v.0 *= 0.5);
+        }),
+        ("gravity on", |world| {
+            world.resource_mut::<Effects>().gravity = Some(DVec2::new(0.0, -9.81));
+        }),
+    ];
+    let solvers = ["discrete", "substeps=4", "soft", "swept", "exact"];
+    for solver in solvers.map(|s| s.parse::<Solver>().unwrap()) {
+        for (what, apply) in changes {
+            let mut app = create_app(CirclesConfig {
+                solver,
+                spawn: SpawnConfig {
+                    count: 40,
+                    ..default()
+                },
+                ..default()
+            });
+            step(&mut app, 20);
+            apply(app.world_mut());
+            let progress = Progress::start(app.world_mut());
+            let bytes = Checkpoint::take(app.world_mut(), "gas", &progress).to_bytes();
+            let (mut resumed, _) = Checkpoint::from_bytes(&bytes, "gas.checkpoint")
+                .and_then(|c| c.resume("gas.checkpoint"))
+                .unwrap_or_else(|e| panic!("{solver}, {what}: our own checkpoint: {e}"));
+            step(&mut app, 30);
+            step(&mut resumed, 30);
+            let (ran, went_on) = (snapshot(app.world_mut()), snapshot(resumed.world_mut()));
+            assert_eq!(
+                ran, went_on,
+                "{solver}, {what}: the resumed run goes elsewhere"
+            );
         }
     }
 }

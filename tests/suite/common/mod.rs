@@ -227,3 +227,6 @@ pub fn assert_scheduled(app: &mut App, system: &str, expected: bool) {
         if expected { "in" } else { "absent from" }
     );
 }
+
+/// Something a test does (a change, a write), with what it is called in its messages.
+pub type Named<F> = (&'static str, F);

@@ -1,0 +1,86 @@
+//! What the checkpoint reader refuses of a checkpoint we wrote, edited: an arena that no longer
+//! holds its circles, an impossible radius, a sleeper that moves or turns, a rotation out of
+//! range, a clock that is not its steps.
+
+use super::*;
+use bevy::math::DVec2;
+
+#[test]
+fn a_checkpoint_whose_arena_no_longer_holds_its_circles_is_refused() {
+    let mut config = CirclesConfig::default();
+    config.spawn.count = 16;
+    config.solver = Solver::Exact;
+    let mut app = headless_app(config);
+    app.update();
+    let progress = Progress::start(app.world_mut());
+    let good = Checkpoint::take(app.world_mut(), "t", &progress);
+    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    // A bound moved within the range of values, past the circles on that side.
+    let mut moved = good.clone();
+    let leftmost = good
+        .circles
+        .iter()
+        .map(|c| c.position.x)
+        .fold(f64::MAX, f64::min);
+    moved.arena.min.x = leftmost + 1e-3;
+    let error = Checkpoint::from_bytes(&moved.to_bytes(), "c")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("outside the arena"), "{error}");
+    moved.arena.min = DVec2::splat(-1e20);
+    moved.arena.max = DVec2::splat(-1e19);
+    assert!(Checkpoint::from_bytes(&moved.to_bytes(), "c").is_err());
+    // A radius a scene could not give: overlaps of it are not measurable.
+    let mut tiny = good.clone();
+    tiny.circles[3].radius = 1e-310;
+    let error = Checkpoint::from_bytes(&tiny.to_bytes(), "c")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("impossible radius"), "{error}");
+    // A sleeper that turns would drive its neighbours like a wheel, and one that moves too
+    // (found by the checkpoint fuzz target: without gravity `exact` flew it on, asleep).
+    for (w, v, says) in [
+        (3.0, 0.0, "asleep but turns"),
+        (0.0, -1.6, "asleep but moves"),
+    ] {
+        let mut woken = good.clone();
+        woken.sleep[2].asleep = true;
+        (woken.circles[2].angular_velocity, woken.circles[2].velocity) = (w, DVec2::X * v);
+        let error = Checkpoint::from_bytes(&woken.to_bytes(), "c").unwrap_err();
+        assert!(error.to_string().contains(says), "{error}");
+    }
+    let mut spun = good.clone();
+    spun.circles[2].rotation = 4.0;
+    let error = Checkpoint::from_bytes(&spun.to_bytes(), "c")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("rotation"), "{error}");
+}
+
+#[test]
+fn a_clock_that_is_not_its_steps_is_refused() {
+    let mut app = headless_app(CirclesConfig {
+        solver: Solver::Swept,
+        ..default()
+    });
+    for _ in 0..40 {
+        app.update();
+    }
+    let progress = Progress::start(app.world_mut());
+    let good = Checkpoint::take(app.world_mut(), "t", &progress);
+    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    // Run backwards (the fuzzer's find: a negative clock hid how coarsely a fast circle's
+    // events resolve) or far ahead.
+    for clock in [
+        -good.steps.sim_seconds,
+        1e12,
+        good.steps.sim_seconds * (1.0 + 1e-9),
+    ] {
+        let mut bad = good.clone();
+        bad.steps.sim_seconds = clock;
+        let error = Checkpoint::from_bytes(&bad.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("its clock"), "{error}");
+    }
+}
