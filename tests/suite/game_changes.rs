@@ -145,9 +145,6 @@ fn a_solver_switched_by_a_system_steps_from_then_on() {
 
 #[test]
 fn a_checkpoint_taken_right_after_a_games_changes_resumes_as_the_run_goes_on() {
-    use moving_circles::checkpoint::Checkpoint;
-    use moving_circles::circle::snapshot;
-    use moving_circles::run::Progress;
     // What a game may do between two steps: steer a few circles (`exact` updates its kept
     // engine), steer them all (it builds afresh), switch gravity on. A checkpoint of the state
     // then must be read back by our own reader and go on as the run does; under `exact` its
@@ -168,8 +165,7 @@ fn a_checkpoint_taken_right_after_a_games_changes_resumes_as_the_run_goes_on() {
             world.resource_mut::<Effects>().gravity = Some(DVec2::new(0.0, -9.81));
         }),
     ];
-    let solvers = ["discrete", "substeps=4", "soft", "swept", "exact"];
-    for solver in solvers.map(|s| s.parse::<Solver>().unwrap()) {
+    for solver in EVERY_SOLVER {
         for (what, apply) in changes {
             let mut app = create_app(CirclesConfig {
                 solver,
@@ -181,18 +177,7 @@ fn a_checkpoint_taken_right_after_a_games_changes_resumes_as_the_run_goes_on() {
             });
             step(&mut app, 20);
             apply(app.world_mut());
-            let progress = Progress::start(app.world_mut());
-            let bytes = Checkpoint::take(app.world_mut(), "gas", &progress).to_bytes();
-            let (mut resumed, _) = Checkpoint::from_bytes(&bytes, "gas.checkpoint")
-                .and_then(|c| c.resume("gas.checkpoint"))
-                .unwrap_or_else(|e| panic!("{solver}, {what}: our own checkpoint: {e}"));
-            step(&mut app, 30);
-            step(&mut resumed, 30);
-            let (ran, went_on) = (snapshot(app.world_mut()), snapshot(resumed.world_mut()));
-            assert_eq!(
-                ran, went_on,
-                "{solver}, {what}: the resumed run goes elsewhere"
-            );
+            assert_resumes_as_the_run_goes_on(&mut app, 30, &format!("{solver}, {what}"));
         }
     }
 }

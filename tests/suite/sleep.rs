@@ -231,8 +231,6 @@ fn a_checkpoint_marking_a_circle_asleep_resumes_under_exact_without_gravity_to_a
 
 #[test]
 fn a_checkpoint_taken_after_your_code_wakes_a_sleeping_circle_resumes_as_the_run_goes_on() {
-    use moving_circles::checkpoint::Checkpoint;
-    use moving_circles::run::Progress;
     // A game sets a sleeping circle moving (or turning) and takes a checkpoint before the next
     // step, which is the one that would wake it. Our reader refuses a circle asleep that moves
     // or turns, so the checkpoint must say it is awake, as the next step makes it.
@@ -256,18 +254,7 @@ fn a_checkpoint_taken_after_your_code_wakes_a_sleeping_circle_resumes_as_the_run
                 .map(|(e, _)| e)
                 .unwrap();
             write(&mut app.world_mut().entity_mut(top));
-            let progress = Progress::start(app.world_mut());
-            let bytes = Checkpoint::take(app.world_mut(), "heap", &progress).to_bytes();
-            let (mut resumed, _) = Checkpoint::from_bytes(&bytes, "heap.checkpoint")
-                .and_then(|c| c.resume("heap.checkpoint"))
-                .unwrap_or_else(|e| panic!("{solver}, {what}: our own checkpoint: {e}"));
-            step(&mut app, 30);
-            step(&mut resumed, 30);
-            let (ran, went_on) = (snapshot(app.world_mut()), snapshot(resumed.world_mut()));
-            assert_eq!(
-                ran, went_on,
-                "{solver}, {what}: the resumed run goes elsewhere"
-            );
+            assert_resumes_as_the_run_goes_on(&mut app, 30, &format!("{solver}, {what}"));
         }
     }
 }

@@ -230,3 +230,21 @@ pub fn assert_scheduled(app: &mut App, system: &str, expected: bool) {
 
 /// Something a test does (a change, a write), with what it is called in its messages.
 pub type Named<F> = (&'static str, F);
+
+/// Takes a checkpoint of `app` as it is now, reads it back with our own reader and resumes it,
+/// then runs both `steps` more: they must end at the same circles, bit for bit. `what` names
+/// the case in the messages.
+pub fn assert_resumes_as_the_run_goes_on(app: &mut App, steps: u64, what: &str) {
+    use moving_circles::checkpoint::Checkpoint;
+    use moving_circles::circle::snapshot;
+    use moving_circles::run::Progress;
+    let progress = Progress::start(app.world_mut());
+    let bytes = Checkpoint::take(app.world_mut(), what, &progress).to_bytes();
+    let (mut resumed, _) = Checkpoint::from_bytes(&bytes, "test.checkpoint")
+        .and_then(|c| c.resume("test.checkpoint"))
+        .unwrap_or_else(|e| panic!("{what}: our own checkpoint: {e}"));
+    step(app, steps);
+    step(&mut resumed, steps);
+    let (ran, went_on) = (snapshot(app.world_mut()), snapshot(resumed.world_mut()));
+    assert_eq!(ran, went_on, "{what}: the resumed run goes elsewhere");
+}
