@@ -6,6 +6,7 @@
 //! (static and kinematic) and sleeping ones are left alone.
 
 use bevy::ecs::schedule::ScheduleLabel;
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::components::{Mass, Sleep, Velocity};
@@ -64,7 +65,9 @@ fn apply_gravity(
 }
 
 /// `v *= exp(-drag·dt)`: the exact solution of `v' = -drag·v` over the step, so it can never
-/// overshoot and reverse a velocity however large `dt` is. Immovable circles keep theirs.
+/// overshoot and reverse a velocity however large `dt` is. Immovable circles keep theirs, and
+/// sleepers at rest are not written (a write wakes them); a sleeper your code set moving, which
+/// this step wakes, is dragged like any moving circle.
 fn apply_drag(
     effects: Res<Effects>,
     dt: Res<StepDt>,
@@ -73,7 +76,7 @@ fn apply_drag(
     let Some(drag) = effects.drag else { return };
     let factor = (-drag * dt.0).exp();
     circles.par_iter_mut().for_each(|(mut v, m, sleep)| {
-        if !m.is_immovable() && !sleep.asleep {
+        if !m.is_immovable() && (!sleep.asleep || v.0 != DVec2::ZERO) {
             v.0 *= factor;
         }
     });

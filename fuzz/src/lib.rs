@@ -8,6 +8,7 @@
 //! - [`checkpoint`]: any bytes as a checkpoint (the kept corpus holds true checkpoints of small
 //!   runs, which libFuzzer mutates); what is accepted is resumed and run a few steps.
 
+use bevy::math::DVec2;
 use moving_circles::arena::{Arena, Boundary};
 use moving_circles::checkpoint::Checkpoint;
 use moving_circles::circle::{CircleState, snapshot};
@@ -162,15 +163,25 @@ pub fn checkpoint(data: &[u8]) {
     read_back(&end, "the checkpoint of a resumed run");
 }
 
-/// Whether no two circles overlap and none touches a segment wall: what the continuous solvers
-/// keep from there on.
+/// Whether no two circles overlap, none touches a segment wall and none reaches past an arena
+/// wall by more than [`ROUNDING`] of its radius: what the continuous solvers keep from there on.
+/// (A circle across a wall, which a checkpoint may hold, is put back inside at its first hit,
+/// into whatever is there: the `checkpoint` target's find, a circle of radius 0.76 reaching
+/// 0.52 past the wall put back into its neighbour.)
 fn apart(circles: &[CircleState], arena: &Arena, segments: &Segments) -> bool {
     let walls = SegmentCells::over_arena(&segments.0, arena);
+    let within_walls = |c: &CircleState| {
+        let reach = DVec2::splat(c.radius * (1.0 - ROUNDING));
+        !arena.has_walls()
+            || (c.position - reach).cmpge(arena.min).all()
+                && (c.position + reach).cmple(arena.max).all()
+    };
     first_overlap(circles, arena).is_none()
         && circles.iter().all(|c| {
-            walls
-                .first_touched(&segments.0, c.position, c.radius)
-                .is_none()
+            within_walls(c)
+                && walls
+                    .first_touched(&segments.0, c.position, c.radius)
+                    .is_none()
         })
 }
 

@@ -253,7 +253,10 @@ pub(super) fn gather_into_engine(
             let changed = (&changed[..], &turned[..]);
             match moved_since(engine, known, changed, &all, restitution_of) {
                 Ok(moved) if moved.is_empty() => return,
-                Ok(moved) if moved.len() <= all.iter().len() / MOVED_FOR_REBUILD => {
+                Ok(mut moved) if moved.len() <= all.iter().len() / MOVED_FOR_REBUILD => {
+                    // In the engine's order, whichever order change detection found them in
+                    // (turned-only circles come last), as a checkpoint's engine applies them.
+                    moved.sort_unstable_by_key(|m| m.index);
                     for m in &moved {
                         if let Some((position, velocity)) = m.motion {
                             engine.set_motion(m.index, position, velocity);
