@@ -16,9 +16,14 @@ const TIME_STEPPED: [&str; 2] = ["soft", "substeps=4"];
 
 /// Twenty balls of radius 0.25 dropped at rest into a narrow box under gravity.
 fn heap(solver: &str) -> App {
+    heap_with(solver, "")
+}
+
+/// [`heap`] with more `effects` (fields of the scene's `effects`, each followed by a comma).
+fn heap_with(solver: &str, effects: &str) -> App {
     let scene = format!(
         "(solver: \"{solver}\", arena: (size: (3.0, 8.0)),
-          effects: (gravity: (0.0, -9.81), restitution: 0.3, wall_restitution: 0.3),
+          effects: ({effects} gravity: (0.0, -9.81), restitution: 0.3, wall_restitution: 0.3),
           mass: Equal(1.0),
           spawn: (count: 20, radius: (0.25, 0.25), speed: (0.0, 0.0), seed: 4))"
     );
@@ -242,9 +247,14 @@ fn a_checkpoint_taken_after_your_code_wakes_a_sleeping_circle_resumes_as_the_run
             circle.get_mut::<AngularVelocity>().unwrap().0 = 2.0
         }),
     ];
-    for solver in ["soft", "substeps=4", "swept", "exact"] {
+    // With drag too, which leaves sleepers at rest alone but drags the one set moving.
+    let solvers = ["soft", "substeps=4", "swept", "exact"];
+    for (solver, effects) in solvers
+        .into_iter()
+        .flat_map(|s| [(s, ""), (s, "drag: 0.5,")])
+    {
         for (what, write) in writes {
-            let mut app = heap(solver);
+            let mut app = heap_with(solver, effects);
             until_asleep(&mut app, 20.0).expect("asleep");
             let top = app
                 .world_mut()
@@ -254,7 +264,9 @@ fn a_checkpoint_taken_after_your_code_wakes_a_sleeping_circle_resumes_as_the_run
                 .map(|(e, _)| e)
                 .unwrap();
             write(&mut app.world_mut().entity_mut(top));
-            assert_resumes_as_the_run_goes_on(&mut app, 30, &format!("{solver}, {what}"));
+            let dragged = if effects.is_empty() { "" } else { " with drag" };
+            let case = format!("{solver}, {what}{dragged}");
+            assert_resumes_as_the_run_goes_on(&mut app, 30, &case);
         }
     }
 }
