@@ -54,7 +54,7 @@ impl EngineState {
     /// engine and circles agree. `None` under the other solvers, which keep nothing between
     /// steps; where the next step would build a fresh engine (the setup or the segment walls
     /// changed, circles came, went or changed their radius or mass, or more than one in
-    /// [`MOVED_FOR_REBUILD`] was moved); and while circles meet nothing (sensors): its cells
+    /// `MOVED_FOR_REBUILD` was moved); and while circles meet nothing (sensors): its cells
     /// are sized without them, and a checkpoint carries no layers. The resumed run then builds
     /// its engine afresh from the state, as the next step would.
     pub fn snapshot(
