@@ -120,7 +120,7 @@ impl CircleState {
 
 /// What a circle is made of, as [`snapshot`] reads it (a circle without spin components
 /// does not turn).
-type Parts = (
+pub(crate) type Parts = (
     &'static Position,
     &'static Velocity,
     &'static Radius,
@@ -148,7 +148,7 @@ pub fn snapshot_with_entities(world: &mut World) -> Vec<(Entity, CircleState)> {
         .collect()
 }
 
-fn from_components(
+pub(crate) fn from_components(
     (p, v, r, m, t, w, a): bevy::ecs::query::QueryItem<'_, '_, Parts>,
 ) -> CircleState {
     CircleState {

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::CirclesPlugins;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, discs, inertia, snapshot, snapshot_with_entities};
+use crate::circle::{CircleState, Parts, discs, from_components, inertia, snapshot};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
 use crate::collision_layers::{Layered, LayeredDisc, layered_disc};
@@ -112,6 +112,11 @@ pub struct Progress {
     pub overlaps: Overlaps,
     /// Wall-clock time spent stepping so far.
     pub stepping: Duration,
+    /// The step of the last sample and the overlaps it measured, which the report's final
+    /// overlaps are when the run ends there (measuring them again costs a second at 5 M
+    /// circles). Not kept in checkpoints: a resumed run has not sampled yet.
+    #[serde(skip)]
+    pub last_sample: Option<(u64, Overlaps)>,
 }
 
 impl Progress {
@@ -203,9 +208,9 @@ fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl Fn
     let step = world.resource::<StepTotals>().steps;
     let circles = snapshot(world);
     let arena = *world.resource::<Arena>();
-    progress
-        .overlaps
-        .add(overlaps_in(world, Some(&circles), &arena));
+    let overlaps = overlaps_in(world, Some(&circles), &arena);
+    progress.overlaps.add(overlaps);
+    progress.last_sample = Some((step, overlaps));
     observe(Sample {
         step,
         circles: &circles,
@@ -215,16 +220,20 @@ fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl Fn
 
 /// Mechanical energy, momentum and counts of the world's circles under its arena and gravity.
 fn totals(world: &mut World) -> Totals {
-    let circles = snapshot_with_entities(world);
-    let own = |e: Entity| world.get::<Inertia>(e).map(|i| i.0);
-    Totals::measure(
-        circles.iter().map(|&(e, c)| {
-            let turning = (c.angular_velocity, inertia(own(e), c.mass, c.radius));
-            (c.position, c.velocity, c.mass, turning)
-        }),
-        world.resource::<Arena>(),
+    let (arena, gravity) = (
+        *world.resource::<Arena>(),
         world.resource::<Effects>().gravity,
-    )
+    );
+    let mut circles = world.query::<(Parts, Option<&Inertia>)>();
+    let measured = circles.iter(world).map(|(parts, own)| {
+        let c = from_components(parts);
+        let turning = (
+            c.angular_velocity,
+            inertia(own.map(|i| i.0), c.mass, c.radius),
+        );
+        (c.position, c.velocity, c.mass, turning)
+    });
+    Totals::measure(measured, &arena, gravity)
 }
 
 /// What a headless run did. Field names and meanings are stable: other tools read them.
@@ -331,12 +340,16 @@ impl Report {
             before,
             overlaps,
             stepping,
+            ..
         } = *progress;
         let elapsed = *world.resource::<StepTotals>();
         let pairs = *world.resource::<PairCollisions>();
         let walls = *world.resource::<WallCollisions>();
         let arena = *world.resource::<Arena>();
-        let final_overlaps = overlaps_in(world, None, &arena);
+        let final_overlaps = match progress.last_sample {
+            Some((step, overlaps)) if step == elapsed.steps => overlaps,
+            _ => overlaps_in(world, None, &arena),
+        };
         let sleeping = world
             .query::<&Sleep>()
             .iter(world)
