@@ -22,7 +22,9 @@ use crate::components::{Inertia, Sleep};
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
+use crate::error::FieldError;
 use crate::exact::EngineState;
+use crate::scene::check::check_motion;
 use crate::schedule::StepTotals;
 use crate::spawn::SpawnReport;
 
@@ -216,6 +218,18 @@ fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl Fn
         circles: &circles,
         world,
     });
+}
+
+/// The first circle of `world` (its index in spawn order) whose position, velocity or turning
+/// has left the range every reader holds values to ([`check_motion`]), and what is wrong.
+/// Inputs at the range's edge can drive a run past it; our outputs of such a state would be
+/// refused by our own readers, so `moving_circles run` writes none (as for a non-finite one).
+pub fn out_of_range(world: &mut World) -> Option<(usize, FieldError)> {
+    let mut circles = world.query::<Parts>();
+    circles
+        .iter(world)
+        .enumerate()
+        .find_map(|(i, parts)| check_motion(&from_components(parts)).err().map(|e| (i, e)))
 }
 
 /// Mechanical energy, momentum and counts of the world's circles under its arena and gravity.

@@ -172,6 +172,16 @@ fn polyline_of(polylines: &[Vec<DVec2>], mut k: usize) -> (usize, usize) {
     (polylines.len(), k)
 }
 
+/// Checks what a run changes of a circle against the range every reader holds values to: its
+/// position and velocity ([`check_vector`]) and how it turns ([`check_spin`]). A run may leave
+/// that range from inputs at its edge (a light circle hit by heavier ones at 10³⁰ m/s goes
+/// faster still); what it then writes would be refused on reading, so it writes nothing.
+pub fn check_motion(c: &CircleState) -> Result<(), FieldError> {
+    check_vector("position", c.position)?;
+    check_vector("velocity", c.velocity)?;
+    check_spin(c)
+}
+
 /// Checks how a circle turns: its rotation in `[-π, π]` (where every solver keeps it) and its
 /// surface no faster than any speed an input may give.
 pub fn check_spin(c: &CircleState) -> Result<(), FieldError> {

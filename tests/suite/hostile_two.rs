@@ -311,3 +311,41 @@ fn a_circle_too_fast_for_the_clock_never_falls_asleep_outside_the_walls() {
     assert_eq!(report["escaped"], 0, "{report}");
     assert_eq!(report["non_finite"], 0, "{report}");
 }
+
+#[test]
+fn a_state_past_the_range_of_values_is_not_written_as_what_our_readers_refuse() {
+    // Found by the checkpoint fuzz target: 14 circles at up to 10³⁰ m/s (the edge of the
+    // range), one of them 340 times lighter than the others. Hits pass it more than 10³⁰ m/s,
+    // and the checkpoint of the run's end was written and then refused by our own reader.
+    // Such a state is refused as a non-finite one is: nothing written, one line saying why.
+    let dir = temp_dir("past-range");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let (report, dump, checkpoint) = (path("r.json"), path("d.txt"), path("c"));
+    let out = crate::common::binary::moving_circles(&[
+        "run",
+        "--resume",
+        "tests/data/checkpoints/past_the_range.checkpoint",
+        "--steps",
+        "1",
+        "--report",
+        &report,
+        "--dump",
+        &dump,
+        "--checkpoint",
+        &checkpoint,
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let said = stderr(&out);
+    assert!(
+        said.contains("left the range of values a file may hold"),
+        "{said}"
+    );
+    assert!(said.contains("velocity"), "{said}");
+    for written in [&report, &dump, &checkpoint] {
+        assert!(
+            !std::path::Path::new(written).exists(),
+            "{written} was written"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

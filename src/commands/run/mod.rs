@@ -18,7 +18,7 @@ use crate::checkpoint::Checkpoint;
 use crate::circle::snapshot;
 use crate::config::Solver;
 use crate::io::{say, write_atomically};
-use crate::run::{Progress, Report, advance, default_sampling, sample_end};
+use crate::run::{Progress, Report, advance, default_sampling, out_of_range, sample_end};
 use crate::scene::particles;
 use crate::schedule::{StepTotals, StopRequest};
 pub use options::{Finished, Input, Length, MAX_STEPS, MAX_THREADS, RunOptions, SolverChoice};
@@ -142,6 +142,12 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             report.non_finite
         );
     }
+    if let Some((i, e)) = out_of_range(app.world_mut()) {
+        bail!(
+            "the run's state left the range of values a file may hold (circle {i}'s {e}); \
+             nothing was written"
+        );
+    }
     if let Some(path) = &options.report {
         let json = serde_json::to_string_pretty(&report).context("serialising the report")?;
         if let Err(e) = write_atomically(path, (json + "\n").as_bytes()) {
@@ -255,6 +261,13 @@ fn write_checkpoint(
     progress: &Progress,
     path: &std::path::Path,
 ) -> anyhow::Result<()> {
+    if let Some((i, e)) = out_of_range(app.world_mut()) {
+        bail!(
+            "not writing the checkpoint to {}: the run's state left the range of values a \
+             file may hold (circle {i}'s {e})",
+            path.display()
+        );
+    }
     let bytes = Checkpoint::take(app.world_mut(), source, progress).to_bytes();
     write_atomically(path, &bytes)
         .with_context(|| format!("writing the checkpoint to {}", path.display()))
