@@ -83,6 +83,37 @@ fn a_refused_compression_names_its_scene() {
 }
 
 #[test]
+fn long_placements_are_announced_as_what_they_are() {
+    // A lattice of a million circles was announced as "placing 1000000 circles at random".
+    let dir = temp_dir("announce");
+    let cases = [
+        (
+            "lattice",
+            "placing on a lattice 1000000 circles",
+            "(size: (30.0, 30.0))",
+            "count: 1000000, radius: (0.01, 0.01)",
+        ),
+        (
+            "pack",
+            "compressing 20000 circles",
+            "(size: (10.0, 10.0))",
+            "count: 20000, radius: (0.01, 0.02)",
+        ),
+    ];
+    for (placement, said, arena, spawn) in cases {
+        let scene = dir.join(format!("{placement}.ron"));
+        let text = format!("(arena: {arena}, spawn: ({spawn}, placement: {placement}))");
+        std::fs::write(&scene, text).unwrap();
+        let out = under_one_gib(&["run", "--scene", scene.to_str().unwrap(), "--steps", "1"]);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{placement}: {err}");
+        assert!(err.contains(said), "{placement}: {err}");
+        assert!(!err.contains("at random"), "{placement}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn an_equation_of_state_of_too_many_disks_blames_n() {
     let dir = temp_dir("eos");
     let out = under_one_gib(&[

@@ -112,7 +112,7 @@ fn a_damaged_snapshot_is_refused_not_followed() {
     let pending = (0..64)
         .find(|&i| good.event[i].kind == Kind::Pair)
         .expect("a pending collision");
-    let damages: [fn(&mut EngineSnapshot, usize); 12] = [
+    let damages: [fn(&mut EngineSnapshot, usize); 14] = [
         |s, _| s.now = f64::NAN,
         |s, _| s.time[3] = f64::NAN,
         |s, _| s.cell_x[5] = 1_000,
@@ -139,6 +139,13 @@ fn a_damaged_snapshot_is_refused_not_followed() {
             s.time[k] += 0.25;
         },
         |s, i| s.time[i] += 1e-9,
+        // An idle circle (nothing ahead, at +∞) given a finite time, or +∞ flipped to -∞ by
+        // one bit: once "entered unreachable code" on popping it.
+        |s, i| s.event[i].kind = Kind::Idle,
+        |s, i| {
+            s.event[i].kind = Kind::Idle;
+            s.time[i] = f64::NEG_INFINITY;
+        },
     ];
     for (k, damage) in damages.into_iter().enumerate() {
         let mut bad = good.clone();
