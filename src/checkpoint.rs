@@ -121,7 +121,12 @@ impl Checkpoint {
             pairs: *world.resource::<PairCollisions>(),
             walls: *world.resource::<WallCollisions>(),
             budget_exhausted,
-            progress: *progress,
+            // What the progress knows of its last sample is not kept (a resumed run has not
+            // sampled), so a checkpoint equals itself read back.
+            progress: Progress {
+                last_sample: None,
+                ..*progress
+            },
             engine,
             contacts,
         }
@@ -202,8 +207,9 @@ impl Checkpoint {
     }
 
     /// Whether the settings and every value are usable (the settings through the same checks
-    /// as a scene's; circles within the physical range). Says what is wrong.
-    fn check(&self) -> Result<(), String> {
+    /// as a scene's; circles within the physical range). Says what is wrong. What the reader
+    /// applies, and what `moving_circles run` applies before it writes one.
+    pub(crate) fn check(&self) -> Result<(), String> {
         let describe = |e: crate::error::FieldError| format!("field `{}`: {}", e.field, e.message);
         self.config().check().map_err(describe)?;
         if self.circles.len() > MAX_CIRCLES {

@@ -70,7 +70,8 @@ pub struct Sample<'a> {
     pub step: u64,
     /// Every circle, in spawn order.
     pub circles: &'a [CircleState],
-    /// The app's world, for anything else.
+    /// The app's world, for anything else. Read it, do not move circles: the report's final
+    /// overlaps are this sample's when the run ends on it.
     pub world: &'a mut World,
 }
 

@@ -378,5 +378,21 @@ fn a_state_past_the_range_of_values_is_not_written_as_what_our_readers_refuse() 
             "{written} was written"
         );
     }
+    // A checkpoint due every step is checked as our reader checks it, and not written either.
+    let out = crate::common::binary::moving_circles(&[
+        "run",
+        "--resume",
+        "tests/data/checkpoints/past_the_range.checkpoint",
+        "--steps",
+        "2",
+        "--checkpoint",
+        &checkpoint,
+        "--every",
+        "1",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let said = stderr(&out);
+    assert!(said.contains("our own reader would refuse it"), "{said}");
+    assert!(!std::path::Path::new(&checkpoint).exists(), "written");
     std::fs::remove_dir_all(&dir).unwrap();
 }

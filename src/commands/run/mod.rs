@@ -143,9 +143,11 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
         );
     }
     if let Some((i, e)) = out_of_range(app.world_mut()) {
+        let also: Vec<String> = failed.iter().map(|e| format!("; {e:#}")).collect();
         bail!(
             "the run's state left the range of values a file may hold (circle {i}'s {e}); \
-             nothing was written"
+             no output of it was written (checkpoints of earlier steps are kept){}",
+            also.concat()
         );
     }
     if let Some(path) = &options.report {
@@ -261,14 +263,16 @@ fn write_checkpoint(
     progress: &Progress,
     path: &std::path::Path,
 ) -> anyhow::Result<()> {
-    if let Some((i, e)) = out_of_range(app.world_mut()) {
+    // Checked as our reader checks it, so that no checkpoint we write is one it refuses (a
+    // state past the range of values, a cached contact impulse past its bound).
+    let checkpoint = Checkpoint::take(app.world_mut(), source, progress);
+    if let Err(why) = checkpoint.check() {
         bail!(
-            "not writing the checkpoint to {}: the run's state left the range of values a \
-             file may hold (circle {i}'s {e})",
+            "not writing the checkpoint to {}: our own reader would refuse it: {why}",
             path.display()
         );
     }
-    let bytes = Checkpoint::take(app.world_mut(), source, progress).to_bytes();
+    let bytes = checkpoint.to_bytes();
     write_atomically(path, &bytes)
         .with_context(|| format!("writing the checkpoint to {}", path.display()))
 }
