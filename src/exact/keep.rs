@@ -34,6 +34,10 @@ pub struct EngineState {
     /// Whether the last write-back found the circles in another order than `entities` (an
     /// entity moved between archetypes), so the next step rebuilds.
     pub(super) reordered: bool,
+    /// Whether a stop request ended the last step early: its engine flew the circles to the
+    /// step's end without predicting again ([`EventEngine::fly_unpredicted_to`]), so it is not
+    /// kept and the next step, if any, rebuilds.
+    pub(super) stopped: bool,
     pub(super) setup: Option<(Arena, Effects, Solver)>,
     /// The segment walls the engine was built with.
     pub(super) segments: Segments,
@@ -68,6 +72,7 @@ impl EngineState {
             && setup.2 == Solver::Exact
             && self.segments == *segments
             && !self.reordered
+            && !self.stopped
             && engine.cells_sized_for_all()
             && circles.len() == self.entities.len()
             && circles.iter().zip(&self.entities).all(|((e, _), k)| e == k);
@@ -148,6 +153,7 @@ impl EngineState {
         self.index.clear();
         self.entities = entities;
         self.reordered = false;
+        self.stopped = false;
     }
 }
 
@@ -228,6 +234,7 @@ pub(super) fn gather_into_engine(
             "a circle lost its restitution or moment of inertia, or its layers changed"
         }
         (Some(_), Solver::Exact) if state.reordered => "circles moved between archetypes",
+        (Some(_), Solver::Exact) if state.stopped => "a stop request ended the last step early",
         (Some(engine), Solver::Exact)
             if state.setup == Some(key) && state.segments == *segments =>
         {
@@ -280,6 +287,15 @@ pub(super) fn gather_into_engine(
     if solver == Solver::Exact {
         debug!("exact engine: rebuilt ({reason})");
     }
+    // Millions of circles take seconds to gather and build: a stop request is heard between
+    // tables. Stopped before every circle was predicted, this step moves nothing.
+    let stopped = || stop.is_some_and(StopRequest::raised);
+    let give_up = |state: &mut EngineState| {
+        debug!("exact engine: build stopped by a stop request");
+        state.engine = None;
+        state.setup = None;
+        state.budget_exhausted += 1;
+    };
     let all = circles.p0();
     let bodies: Vec<CircleState> = all
         .iter()
@@ -300,6 +316,9 @@ pub(super) fn gather_into_engine(
         .map(|c| rest_of(c.6, c.2.0 != DVec2::ZERO))
         .collect();
     let entities: Vec<Entity> = all.iter().map(|(e, ..)| e).collect();
+    if stopped() {
+        return give_up(state);
+    }
     let spins = circles.p3();
     for (r, &e) in rest.iter_mut().zip(&entities).filter(|(r, _)| r.asleep) {
         if let Ok((Some(spin), ..)) = spins.get(e)
@@ -311,7 +330,6 @@ pub(super) fn gather_into_engine(
     let all = circles.p0();
     let layers = own.filters.gather(entities.iter().copied());
     let restitutions = (effects.restitution, effects.wall_restitution);
-    let stopped = || stop.is_some_and(StopRequest::raised);
     let fall = (effects.gravity, &rest[..]);
     let Some(mut engine) = EventEngine::build_until(
         &bodies,
@@ -322,17 +340,12 @@ pub(super) fn gather_into_engine(
         layers,
         stopped,
     ) else {
-        // Stopped before every circle was predicted: this step moves nothing, and the next
-        // one builds again.
-        debug!("exact engine: build stopped by a stop request");
-        state.engine = None;
-        state.setup = None;
-        state.budget_exhausted += 1;
-        return;
+        return give_up(state);
     };
     if own.restitution {
         engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());
     }
+
     if effects.is_rough() {
         let turning = turning_of(&circles.p3(), entities.iter().copied());
         engine.make_rough(roughness(&effects), turning.iter().map(|t| t.turn));

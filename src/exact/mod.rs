@@ -275,11 +275,18 @@ fn advance_engine(
         return;
     };
     let budget = budget.for_step(solver, engine.len());
+
     let t_start = engine.now();
     let t_end = t_start + dt;
     let stop = || stop.is_some_and(StopRequest::raised);
     if engine.advance_until_stopped(t_end, budget, stop).is_err() {
-        engine.drift_to(t_end);
+        if stop() {
+            // The run ends after this step: its engine is read back, not kept.
+            engine.fly_unpredicted_to(t_end);
+            state.stopped = true;
+        } else {
+            engine.drift_to(t_end);
+        }
         state.budget_exhausted += 1;
     }
     if let Some(log) = engine.drain_hits() {

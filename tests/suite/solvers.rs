@@ -11,7 +11,11 @@ use moving_circles::exact::EngineState;
 use moving_circles::prelude::*;
 
 fn gas_1000(solver: Solver) -> App {
-    let config = CirclesConfig {
+    create_app(gas_1000_config(solver))
+}
+
+fn gas_1000_config(solver: Solver) -> CirclesConfig {
+    CirclesConfig {
         arena: Arena::centered(DVec2::new(10.4, 5.85)),
         spawn: SpawnConfig {
             area_fraction: Some(0.3),
@@ -22,8 +26,7 @@ fn gas_1000(solver: Solver) -> App {
         },
         solver,
         ..default()
-    };
-    create_app(config)
+    }
 }
 
 fn drift_over_100_seconds(solver: Solver) -> (f64, u64) {
@@ -305,6 +308,53 @@ fn an_event_budget_bounds_the_work_of_a_step() {
         assert_eq!(
             bounded.world().resource::<CircleDiagnostics>().non_finite,
             0
+        );
+    }
+}
+
+#[test]
+fn a_step_a_stop_request_ends_is_not_kept_and_the_run_goes_on_from_where_it_stopped() {
+    use moving_circles::schedule::{StepTotals, StopRequest};
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    // `swept` hears the request while it gathers (the step moves nothing); `exact`, whose
+    // engine is kept, after a few thousand of the step's events: it flies every circle to the
+    // step's end without predicting again, so the engine must not be kept.
+    for solver in [Solver::Swept, Solver::Exact] {
+        // Steps of a second: tens of thousands of events each.
+        let mut app = create_app(CirclesConfig {
+            dt: 1.0,
+            ..gas_1000_config(solver)
+        });
+        step(&mut app, 3);
+        let stop = StopRequest(Arc::new(AtomicBool::new(true)));
+        app.insert_resource(stop.clone());
+        let (steps, cut, rebuilds) = {
+            let world = app.world();
+            let state = world.resource::<EngineState>();
+            let totals = world.resource::<StepTotals>();
+            (totals.steps, state.budget_exhausted, state.rebuilds)
+        };
+        step(&mut app, 1);
+        stop.0.store(false, Ordering::Relaxed);
+        let state = app.world().resource::<EngineState>();
+        assert_eq!(
+            state.budget_exhausted,
+            cut + 1,
+            "{solver}: the step was not cut short"
+        );
+        assert_eq!(app.world().resource::<StepTotals>().steps, steps + 1);
+        if solver == Solver::Exact {
+            assert_eq!(
+                state.rebuilds, rebuilds,
+                "{solver}: the stopped step rebuilt"
+            );
+        }
+        assert_resumes_as_the_run_goes_on(&mut app, 3, &format!("{solver} after a stop"));
+        let state = app.world().resource::<EngineState>();
+        assert!(
+            state.rebuilds > rebuilds,
+            "{solver}: the step after the stop went on with an engine it had not predicted"
         );
     }
 }

@@ -52,8 +52,15 @@ impl EventEngine {
         gravity: DVec2,
         rest: &[Rest],
     ) -> Self {
-        let mut engine =
-            Self::placed_falling(circles, arena, segments, restitutions, (gravity, rest), &[]);
+        let mut engine = Self::placed_falling(
+            circles,
+            arena,
+            segments,
+            restitutions,
+            (gravity, rest),
+            (&[], &|| false),
+        )
+        .expect("a build never asked to stop finishes");
         engine.predict_all();
         engine
     }
@@ -73,33 +80,46 @@ impl EventEngine {
     ) -> Option<Self> {
         assert!(layers.is_empty() || layers.len() == circles.len());
         let mut engine = match gravity {
-            Some(g) => {
-                Self::placed_falling(circles, arena, segments, restitutions, (g, rest), &layers)
-            }
+            Some(g) => Self::placed_falling(
+                circles,
+                arena,
+                segments,
+                restitutions,
+                (g, rest),
+                (&layers, &stop),
+            ),
             None => Self::placed(
                 circles,
                 arena,
                 segments,
                 restitutions,
                 cell_width(arena, circles, &layers),
-                &layers,
+                (&layers, &stop),
             ),
-        };
+        }?;
         engine.layers = layers;
         engine.predict_all_until(stop).then_some(engine)
     }
 
-    /// [`EventEngine::falling`] before any prediction: every circle in its cell.
+    /// [`EventEngine::falling`] before any prediction: every circle in its cell (`None` when
+    /// `stop` asked to give up).
     fn placed_falling(
         circles: &[CircleState],
         arena: &Arena,
         segments: &[Segment],
         restitutions: (f64, f64),
         (gravity, rest): (DVec2, &[Rest]),
-        layers: &[CollisionLayers],
-    ) -> Self {
+        (layers, stop): (&[CollisionLayers], &impl Fn() -> bool),
+    ) -> Option<Self> {
         let width = cell_width(arena, circles, layers);
-        let mut engine = Self::lay_out(circles, arena, segments, restitutions, (width, layers));
+        let mut engine = Self::lay_out(
+            circles,
+            arena,
+            segments,
+            restitutions,
+            (width, layers),
+            stop,
+        )?;
         engine.gravity = gravity;
         for i in 0..engine.len() {
             let at_rest = rest.get(i).copied().unwrap_or_default();
@@ -111,7 +131,7 @@ impl EventEngine {
             engine.falls[i] = engine.can_fall(i);
         }
         engine.relink_all();
-        engine
+        Some(engine)
     }
 
     /// [`EventEngine::new`] on cells at least `width` wide (and a largest diameter).
@@ -122,34 +142,54 @@ impl EventEngine {
         restitutions: (f64, f64),
         width: f64,
     ) -> Self {
-        let mut engine = Self::placed(circles, arena, segments, restitutions, width, &[]);
+        let mut engine = Self::placed(
+            circles,
+            arena,
+            segments,
+            restitutions,
+            width,
+            (&[], &|| false),
+        )
+        .expect("a build never asked to stop finishes");
         engine.predict_all();
         engine
     }
 
-    /// [`EventEngine::with_cells`] before any prediction: every circle in its cell.
+    /// [`EventEngine::with_cells`] before any prediction: every circle in its cell (`None` when
+    /// `stop` asked to give up).
     fn placed(
         circles: &[CircleState],
         arena: &Arena,
         segments: &[Segment],
         restitutions: (f64, f64),
         width: f64,
-        layers: &[CollisionLayers],
-    ) -> Self {
-        let mut engine = Self::lay_out(circles, arena, segments, restitutions, (width, layers));
+        (layers, stop): (&[CollisionLayers], &impl Fn() -> bool),
+    ) -> Option<Self> {
+        let mut engine = Self::lay_out(
+            circles,
+            arena,
+            segments,
+            restitutions,
+            (width, layers),
+            stop,
+        )?;
         engine.relink_all();
-        engine
+        Some(engine)
     }
 
     /// The engine's state for `circles` at time 0, before any circle is put in a cell or
-    /// predicted, on cells sized for the circles that meet another under `layers`.
+    /// predicted, on cells sized for the circles that meet another under `layers`. Millions of
+    /// circles take a second or more to lay out, mostly memory first touched: `stop` is asked
+    /// between the largest tables (`None` when it asked to give up).
     fn lay_out(
         circles: &[CircleState],
         arena: &Arena,
         segments: &[Segment],
         (restitution, wall_restitution): (f64, f64),
         (width, layers): (f64, &[CollisionLayers]),
-    ) -> Self {
+        stop: &impl Fn() -> bool,
+    ) -> Option<Self> {
+        let go_on = || (!stop()).then_some(());
         let n = circles.len();
         let size = arena.size();
         let Layout {
@@ -160,38 +200,49 @@ impl EventEngine {
             reach,
             images_wrap,
         } = walls_inside(arena, circles, segments, width, layers);
-        Self {
+        go_on()?;
+        let motion = circles
+            .iter()
+            .map(|c| Motion {
+                pos: if arena.is_periodic() {
+                    arena.wrap(c.position)
+                } else {
+                    c.position
+                },
+                vel: c.velocity,
+                t_at: 0.0,
+                radius: c.radius,
+            })
+            .collect();
+        go_on()?;
+        let inv_mass = circles.iter().map(CircleState::inv_mass).collect();
+        let idle = Event {
+            kind: Kind::Idle,
+            partner: NONE,
+            partner_count: 0,
+        };
+        let event = vec![idle; n];
+        go_on()?;
+        let queue = EventQueue::new(n);
+        go_on()?;
+        let cells = CellMembers::new(grid.len(), n);
+        let best_pair = vec![NO_PAIR; n];
+        go_on()?;
+        let (last_hit, anchor) = (vec![f64::NEG_INFINITY; n], vec![(DVec2::INFINITY, 0.0); n]);
+        go_on()?;
+        Some(Self {
             arena: *arena,
             period: size,
             restitution,
             wall_restitution,
             now: 0.0,
-            motion: circles
-                .iter()
-                .map(|c| Motion {
-                    pos: if arena.is_periodic() {
-                        arena.wrap(c.position)
-                    } else {
-                        c.position
-                    },
-                    vel: c.velocity,
-                    t_at: 0.0,
-                    radius: c.radius,
-                })
-                .collect(),
-            inv_mass: circles.iter().map(CircleState::inv_mass).collect(),
+            motion,
+            inv_mass,
             counter: vec![0; n],
-            event: vec![
-                Event {
-                    kind: Kind::Idle,
-                    partner: NONE,
-                    partner_count: 0
-                };
-                n
-            ],
-            best_pair: vec![NO_PAIR; n],
-            queue: EventQueue::new(n),
-            cells: CellMembers::new(grid.len(), n),
+            event,
+            best_pair,
+            queue,
+            cells,
             grid,
             cell_x: vec![0; n],
             cell_y: vec![0; n],
@@ -208,11 +259,11 @@ impl EventEngine {
             gravity: DVec2::ZERO,
             falls: vec![false; n],
             asleep: vec![false; n],
-            last_hit: vec![f64::NEG_INFINITY; n],
+            last_hit,
             quick_hits: vec![0; n],
-            anchor: vec![(DVec2::INFINITY, 0.0); n],
+            anchor,
             spins: None,
-        }
+        })
     }
 }
 
@@ -234,26 +285,28 @@ mod tests {
             })
             .collect();
         let (restitutions, fall) = ((1.0, 1.0), (None, &[][..]));
-        // Asked once per STOP_POLL_CIRCLES predictions, and told to stop the second time.
-        let asked = Cell::new(0);
-        let stop = || {
-            asked.set(asked.get() + 1);
-            asked.get() == 2
-        };
-        assert!(
+        let build = |stop: &dyn Fn() -> bool| {
             EventEngine::build_until(&circles, &arena, &[], restitutions, fall, Vec::new(), stop)
-                .is_none()
-        );
-        assert_eq!(asked.get(), 2);
-        let whole = EventEngine::build_until(
-            &circles,
-            &arena,
-            &[],
-            restitutions,
-            fall,
-            Vec::new(),
-            || false,
-        );
+        };
+        // A whole build looks between the layout's tables and every STOP_POLL_CIRCLES
+        // predictions; told to stop at any of those looks, it gives up there.
+        let asked = Cell::new(0);
+        let whole = build(&|| {
+            asked.set(asked.get() + 1);
+            false
+        });
+        let looks = asked.get();
+        let predicting = circles.len().div_ceil(STOP_POLL_CIRCLES);
+        assert!(looks > predicting + 3, "{looks} looks");
+        for stop_at in 1..=looks {
+            let asked = Cell::new(0);
+            let stopped = build(&|| {
+                asked.set(asked.get() + 1);
+                asked.get() == stop_at
+            });
+            assert!(stopped.is_none(), "went on at look {stop_at}");
+            assert_eq!(asked.get(), stop_at);
+        }
         let new = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
         assert_eq!(whole.map(|e| e.snapshot()), Some(new.snapshot()));
     }
