@@ -14,10 +14,10 @@ use serde::{Deserialize, Serialize};
 use crate::CirclesPlugins;
 use crate::arena::Arena;
 use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, Parts, discs, from_components, inertia, snapshot};
+use crate::circle::{CircleState, Parts, from_components, inertia, snapshot};
 use crate::collide::PairCollisions;
 use crate::collide::overlaps::Overlaps;
-use crate::collision_layers::{Layered, LayeredDisc, layered_disc};
+use crate::collision_layers::{LayeredDisc, layered_disc};
 use crate::components::{Inertia, Sleep};
 use crate::config::{CirclesConfig, Effects, Solver};
 use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
@@ -68,11 +68,17 @@ pub fn headless_app_with(config: CirclesConfig, setup: impl FnOnce(&mut App)) ->
 pub struct Sample<'a> {
     /// Steps done so far.
     pub step: u64,
-    /// Every circle, in spawn order.
-    pub circles: &'a [CircleState],
-    /// The app's world, for anything else. Read it, do not move circles: the report's final
-    /// overlaps are this sample's when the run ends on it.
+    /// The app's world. Read it, do not move circles: the report's final overlaps are this
+    /// sample's when the run ends on it.
     pub world: &'a mut World,
+}
+
+impl Sample<'_> {
+    /// Every circle, in spawn order: a [`snapshot`], taken when asked for (a run that only
+    /// counts steps never copies its millions of circles).
+    pub fn circles(&mut self) -> Vec<CircleState> {
+        snapshot(self.world)
+    }
 }
 
 /// How often [`run_steps`] samples the state by default: after every step up to 10 000
@@ -189,36 +195,19 @@ pub fn sample_end(
     }
 }
 
-/// The overlaps between the circles of `world` that meet: those of `circles` (its snapshot,
-/// if taken) when no circle has layers or is a sensor.
-fn overlaps_in(world: &mut World, circles: Option<&[CircleState]>, arena: &Arena) -> Overlaps {
-    if world
-        .query_filtered::<(), Layered>()
-        .iter(world)
-        .next()
-        .is_none()
-    {
-        return match circles {
-            Some(circles) => Overlaps::measure(&discs(circles), arena, &[]),
-            None => Overlaps::measure(&discs(&snapshot(world)), arena, &[]),
-        };
-    }
+/// The overlaps between the circles of `world` that meet.
+fn overlaps_in(world: &mut World, arena: &Arena) -> Overlaps {
     let mut circles = world.query::<LayeredDisc>();
     Overlaps::measure_layered(circles.iter(world).map(layered_disc), arena)
 }
 
 fn take_sample(world: &mut World, progress: &mut Progress, observe: &mut impl FnMut(Sample)) {
     let step = world.resource::<StepTotals>().steps;
-    let circles = snapshot(world);
     let arena = *world.resource::<Arena>();
-    let overlaps = overlaps_in(world, Some(&circles), &arena);
+    let overlaps = overlaps_in(world, &arena);
     progress.overlaps.add(overlaps);
     progress.last_sample = Some((step, overlaps));
-    observe(Sample {
-        step,
-        circles: &circles,
-        world,
-    });
+    observe(Sample { step, world });
 }
 
 /// The first circle of `world` (its index in spawn order) whose position, velocity or turning
@@ -363,7 +352,7 @@ impl Report {
         let arena = *world.resource::<Arena>();
         let final_overlaps = match progress.last_sample {
             Some((step, overlaps)) if step == elapsed.steps => overlaps,
-            _ => overlaps_in(world, None, &arena),
+            _ => overlaps_in(world, &arena),
         };
         let sleeping = world
             .query::<&Sleep>()

@@ -95,12 +95,13 @@ pub fn trace(case: &Case, solver: Solver, dt: f64) -> Trace {
     let mut before = snapshot(app.world_mut());
     let mean_radius = before.iter().map(|c| c.radius).sum::<f64>() / before.len().max(1) as f64;
     let (mut tunnelled, mut at_horizon) = (0, Vec::new());
-    let report = run_steps(&mut app, &case.name, steps, 1, |sample| {
-        tunnelled += passed_through(&before, sample.circles, &arena);
+    let report = run_steps(&mut app, &case.name, steps, 1, |mut sample| {
+        let now = sample.circles();
+        tunnelled += passed_through(&before, &now, &arena);
         if sample.step == horizon_step {
-            at_horizon = sample.circles.to_vec();
+            at_horizon = now.clone();
         }
-        before = sample.circles.to_vec();
+        before = now;
     });
     Trace {
         solver,

@@ -81,8 +81,9 @@ pub fn measure_pile(case: &Case, solver: Solver, dt: f64) -> PileRow {
     let steps = (case.seconds / dt).round().max(1.0) as u64;
     // The first step of the last stretch below the settled energy, if it lasts to the end.
     let (mut scale, mut below_since) = (0.0, Some(0u64));
-    let report = run_steps(&mut app, &case.name, steps, 1, |sample| {
-        let movable = sample.circles.iter().filter(|c| c.mass.is_finite());
+    let report = run_steps(&mut app, &case.name, steps, 1, |mut sample| {
+        let circles = sample.circles();
+        let movable = circles.iter().filter(|c| c.mass.is_finite());
         let (count, mass, radius, kinetic) = movable.fold((0.0, 0.0, 0.0, 0.0), |acc, c| {
             let kinetic = 0.5 * c.mass * c.velocity.length_squared();
             (

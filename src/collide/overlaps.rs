@@ -25,18 +25,25 @@ pub fn overlapping_circles(
     arena: &Arena,
     layers: &[CollisionLayers],
 ) -> Vec<(usize, usize, f64)> {
-    let mut pairs = Vec::new();
-    overlapping_pairs(&mut CellList::default(), arena, circles, &mut pairs);
-    pairs.retain(|&(i, j)| pair_meets(layers, i as usize, j as usize));
-    pairs.sort_unstable();
-    pairs
-        .into_iter()
+    pairs_that_meet(circles, arena, layers)
         .map(|(i, j)| {
-            let (i, j) = (i as usize, j as usize);
             let ((p, r), (q, s)) = (circles[i], circles[j]);
             (i, j, r + s - arena.offset(p, q).length())
         })
         .collect()
+}
+
+/// The overlapping pairs of `circles` that meet under `layers`, sorted.
+fn pairs_that_meet(
+    circles: &[(DVec2, f64)],
+    arena: &Arena,
+    layers: &[CollisionLayers],
+) -> impl Iterator<Item = (usize, usize)> {
+    let mut pairs = Vec::new();
+    overlapping_pairs(&mut CellList::default(), arena, circles, &mut pairs);
+    pairs.retain(|&(i, j)| pair_meets(layers, i as usize, j as usize));
+    pairs.sort_unstable();
+    pairs.into_iter().map(|(i, j)| (i as usize, j as usize))
 }
 
 /// Overlaps in one or more states, each as a fraction of the pair's smaller radius.
@@ -55,8 +62,10 @@ impl Overlaps {
     /// meet given each circle's `layers` (empty: every pair meets).
     pub fn measure(circles: &[(DVec2, f64)], arena: &Arena, layers: &[CollisionLayers]) -> Self {
         let mut overlaps = Self::default();
-        for (i, j, depth) in overlapping_circles(circles, arena, layers) {
-            let fraction = depth / circles[i].1.min(circles[j].1);
+        // Summed in the sorted pairs' order, whatever order the broad phase found them in.
+        for (i, j) in pairs_that_meet(circles, arena, layers) {
+            let ((p, r), (q, s)) = (circles[i], circles[j]);
+            let fraction = (r + s - arena.offset(p, q).length()) / r.min(s);
             overlaps.pairs += 1;
             overlaps.max = overlaps.max.max(fraction);
             overlaps.sum += fraction;
@@ -70,7 +79,7 @@ impl Overlaps {
         circles: impl Iterator<Item = (DVec2, f64, CollisionLayers)>,
         arena: &Arena,
     ) -> Self {
-        let (mut discs, mut layers) = (Vec::new(), Vec::new());
+        let (mut discs, mut layers) = (Vec::with_capacity(circles.size_hint().0), Vec::new());
         for (p, r, own) in circles {
             // Layers listed from the first circle that has its own on (none: all meet).
             if !layers.is_empty() || own != CollisionLayers::DEFAULT {

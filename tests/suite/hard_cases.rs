@@ -78,8 +78,8 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
     let mut longest_overlap_steps = 0;
     let mut overlapped_for: HashMap<(usize, usize), u32> = HashMap::new();
     let mut end = Vec::new();
-    let report = run_steps(&mut app, name, steps, 1, |sample| {
-        let now = sample.circles;
+    let report = run_steps(&mut app, name, steps, 1, |mut sample| {
+        let now = &sample.circles();
         let mut still = HashMap::new();
         for (i, j, depth) in overlapping_circles(&discs(now), &arena, &[]) {
             // Touching to rounding (exactly touching circles) is contact, not an overlap to fix.
