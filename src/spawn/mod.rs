@@ -39,7 +39,8 @@ pub struct SpawnReport {
     /// Why no random circles were placed, when the rules could not be followed (a compression
     /// that jammed, say).
     pub refused: Option<String>,
-    /// Whether a [`StopRequest`] ended the placement: no random circles were placed.
+    /// Whether a [`StopRequest`] ended the placement (no random circles were placed) or the
+    /// spawning (circles after the last batch were not spawned).
     pub interrupted: bool,
 }
 
@@ -120,8 +121,8 @@ fn spawn_circles(mut commands: Commands, placing: Placing) {
             (Some(Vec::new()), Some(e.to_string()))
         }
     };
-    let interrupted = random.is_none();
-    let random = random.unwrap_or_default();
+    let interrupted = random.is_none() || stopped();
+    let random = random.filter(|_| !interrupted).unwrap_or_default();
     if random.len() < requested && !interrupted {
         warn!(
             "placed {} of {requested} random circles: the arena has no room for more without overlap",
@@ -135,13 +136,23 @@ fn spawn_circles(mut commands: Commands, placing: Placing) {
         refused,
         interrupted,
     };
-    let bundles: Vec<_> = fixed
-        .0
-        .iter()
-        .chain(&random)
-        .map(CircleState::bundle)
-        .collect();
-    commands.spawn_batch(bundles);
+    let mut circles = fixed.0.clone();
+    circles.extend(random);
+    let stop = stop.map(|s| s.clone());
+    commands.queue(move |world: &mut World| spawn_until(world, &circles, stop));
+}
+
+/// Spawns `circles` in batches, asking `stop` between them: millions of entities take a
+/// second or more to spawn. A stop leaves the rest unspawned and the placement marked
+/// [interrupted](SpawnReport::interrupted).
+fn spawn_until(world: &mut World, circles: &[CircleState], stop: Option<StopRequest>) {
+    for batch in circles.chunks(STOP_POLL_PLACED) {
+        if stop.as_ref().is_some_and(StopRequest::raised) {
+            world.resource_mut::<SpawnReport>().interrupted = true;
+            return;
+        }
+        world.spawn_batch(batch.iter().map(CircleState::bundle));
+    }
 }
 
 /// How many circles the [`DropConfig`] has dropped since the last (re)spawn.

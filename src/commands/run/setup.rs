@@ -71,7 +71,8 @@ pub(super) fn set_threads(threads: Option<u16>) {
 }
 
 /// The headless app of `config` from `source`, its circles placed (saying so first when that
-/// takes a while, and afterwards when not all fit); `None` if `stop` was raised while placing.
+/// takes a while, and afterwards when not all fit); `None` if `stop` was raised while placing
+/// or spawning them.
 pub(super) fn start(
     config: CirclesConfig,
     source: &str,
@@ -90,11 +91,15 @@ pub(super) fn start(
     if placing >= announce_from {
         eprintln!("moving_circles: {how} {placing} circles (this takes a while)");
     }
+    let asked = stop.clone();
     let app = headless_app_with(config, |app| {
         app.insert_resource(stop);
     });
     let spawn = app.world().resource::<SpawnReport>();
-    if spawn.interrupted {
+    if spawn.interrupted || asked.raised() {
+        // Raised while the circles were placed, or spawned (a second for millions): nothing
+        // was run, and the process exits next, so the system takes the world's memory back.
+        std::mem::forget(app);
         return Ok(None);
     }
     if let Some(refused) = &spawn.refused {
