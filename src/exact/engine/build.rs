@@ -18,6 +18,27 @@ use crate::segment::Segment;
 /// milliseconds of work.
 pub const STOP_POLL_CIRCLES: usize = 16_384;
 
+/// Entries of a table laid out between two looks at the stop request: a few megabytes, first
+/// touched in some tens of milliseconds.
+const STOP_POLL_ENTRIES: usize = 1 << 18;
+
+/// `(0..n).map(entry)` collected, asking `stop` every [`STOP_POLL_ENTRIES`] entries: `None`
+/// when it asked to give up. A table of millions takes a good part of a second to touch.
+fn table_until<T>(
+    n: usize,
+    entry: impl Fn(usize) -> T,
+    stop: &impl Fn() -> bool,
+) -> Option<Vec<T>> {
+    let mut table = Vec::with_capacity(n);
+    for start in (0..n).step_by(STOP_POLL_ENTRIES) {
+        if stop() {
+            return None;
+        }
+        table.extend((start..n.min(start + STOP_POLL_ENTRIES)).map(&entry));
+    }
+    Some(table)
+}
+
 impl EventEngine {
     /// Builds the engine at time 0 and predicts every circle's first event. Circles must have
     /// finite state; with walls their centres must lie within `[min + r, max - r]` (a centre
@@ -180,7 +201,7 @@ impl EventEngine {
     /// The engine's state for `circles` at time 0, before any circle is put in a cell or
     /// predicted, on cells sized for the circles that meet another under `layers`. Millions of
     /// circles take a second or more to lay out, mostly memory first touched: `stop` is asked
-    /// between the largest tables (`None` when it asked to give up).
+    /// as the tables fill (`None` when it asked to give up).
     fn lay_out(
         circles: &[CircleState],
         arena: &Arena,
@@ -200,35 +221,37 @@ impl EventEngine {
             reach,
             images_wrap,
         } = walls_inside(arena, circles, segments, width, layers);
-        go_on()?;
-        let motion = circles
-            .iter()
-            .map(|c| Motion {
-                pos: if arena.is_periodic() {
-                    arena.wrap(c.position)
-                } else {
-                    c.position
-                },
-                vel: c.velocity,
-                t_at: 0.0,
-                radius: c.radius,
-            })
-            .collect();
-        go_on()?;
-        let inv_mass = circles.iter().map(CircleState::inv_mass).collect();
+        let motion = table_until(
+            n,
+            |i| {
+                let c = &circles[i];
+                Motion {
+                    pos: if arena.is_periodic() {
+                        arena.wrap(c.position)
+                    } else {
+                        c.position
+                    },
+                    vel: c.velocity,
+                    t_at: 0.0,
+                    radius: c.radius,
+                }
+            },
+            stop,
+        )?;
+        let inv_mass = table_until(n, |i| circles[i].inv_mass(), stop)?;
         let idle = Event {
             kind: Kind::Idle,
             partner: NONE,
             partner_count: 0,
         };
-        let event = vec![idle; n];
+        let event = table_until(n, |_| idle, stop)?;
+        let best_pair = table_until(n, |_| NO_PAIR, stop)?;
+        let last_hit = table_until(n, |_| f64::NEG_INFINITY, stop)?;
+        let anchor = table_until(n, |_| (DVec2::INFINITY, 0.0), stop)?;
         go_on()?;
         let queue = EventQueue::new(n);
         go_on()?;
         let cells = CellMembers::new(grid.len(), n);
-        let best_pair = vec![NO_PAIR; n];
-        go_on()?;
-        let (last_hit, anchor) = (vec![f64::NEG_INFINITY; n], vec![(DVec2::INFINITY, 0.0); n]);
         go_on()?;
         Some(Self {
             arena: *arena,
