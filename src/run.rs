@@ -88,8 +88,8 @@ pub fn default_sampling(circles: usize) -> u64 {
 }
 
 /// Steps `app` `steps` times, timing the steps alone. After every `sample_every`-th step (and
-/// the last) it takes a snapshot, measures its overlaps and hands it to `observe`, outside the
-/// timed stepping. Returns the report of the run, with `source` as its source.
+/// the last) it measures the overlaps and hands a [`Sample`] to `observe`, outside the timed
+/// stepping. Returns the report of the run, with `source` as its source.
 pub fn run_steps(
     app: &mut App,
     source: &str,
@@ -143,10 +143,9 @@ impl Progress {
 /// [`CircleDiagnostics`](crate::diagnostics::CircleDiagnostics) are not measured
 /// ([`Measuring::AfterSpawn`]; the run takes its own totals), so they are stale until the app's
 /// next step after this. After every step whose number is a multiple of `sample_every` it
-/// measures the overlaps of a snapshot into `progress` and hands the snapshot
-/// to `observe`. Step numbers count from the start of the run, so a run resumed from a
+/// measures the overlaps into `progress` and hands a [`Sample`] to `observe`. Step numbers count from the start of the run, so a run resumed from a
 /// checkpoint samples exactly the steps the whole run would have. Returns whether `stop` ended
-/// it early.
+/// it early, or was raised by the end (it may have cut the last step short).
 pub fn advance(
     app: &mut App,
     progress: &mut Progress,
@@ -162,7 +161,7 @@ pub fn advance(
     let stopped = loop {
         let step = app.world().resource::<StepTotals>().steps;
         if step >= until {
-            break false;
+            break stop();
         }
         if stop() {
             break true;

@@ -104,8 +104,9 @@ impl StepTotals {
 /// A request from outside the app (the command line's signal handler) to end the current step
 /// as soon as it can: the event engine, which can spend seconds in one step, then ends it as
 /// when its event budget runs out (everything drifts to the step's end, counted in
-/// `budget_exhausted`); a build of the engine it stops moves nothing that step (also counted);
-/// a placement of circles it stops places no random circles ([`SpawnReport::interrupted`]).
+/// `budget_exhausted`, and the engine is not kept); a build of the engine it stops moves
+/// nothing that step (also counted); a placement of circles it stops places no random circles,
+/// and a spawning it stops spawns no more batches ([`SpawnReport::interrupted`]).
 /// Absent, or never set, nothing changes.
 ///
 /// [`SpawnReport::interrupted`]: crate::spawn::SpawnReport::interrupted

@@ -32,7 +32,8 @@ pub struct Respawn;
 pub struct SpawnReport {
     /// Circles requested.
     pub requested: usize,
-    /// Circles placed.
+    /// Circles placed (all spawned, unless a stop [interrupted](Self::interrupted) the
+    /// spawning).
     pub placed: usize,
     /// Increases with every placement, so observers can tell a reset happened.
     pub generation: u64,

@@ -312,7 +312,10 @@ fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
     let mut stdout = String::new();
     std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
     assert_eq!(status.code(), Some(143), "{stdout}");
-    assert!(stdout.contains("while placing circles"), "{stdout}");
+    assert!(
+        stdout.contains("while placing or spawning circles"),
+        "{stdout}"
+    );
     assert_eq!(
         text(&report),
         "old",

@@ -358,3 +358,32 @@ fn a_step_a_stop_request_ends_is_not_kept_and_the_run_goes_on_from_where_it_stop
         );
     }
 }
+
+#[test]
+fn a_stop_raised_during_the_last_step_is_reported_as_ending_the_run() {
+    use moving_circles::run::{Progress, advance};
+    use moving_circles::schedule::StepTotals;
+    use std::cell::Cell;
+    // The stop comes while the run's last step runs (it may have cut it short): the run says
+    // it was stopped, as the command line then reports it interrupted.
+    let mut app = gas_1000(Solver::Exact);
+    let mut progress = Progress::start(app.world_mut());
+    let until = app.world().resource::<StepTotals>().steps + 1;
+    let asked = Cell::new(0);
+    let stop = || {
+        asked.set(asked.get() + 1);
+        asked.get() > 1
+    };
+    assert!(advance(&mut app, &mut progress, until, 1, stop, |_| {}));
+    assert_eq!(app.world().resource::<StepTotals>().steps, until);
+    // Never raised, the same run ends as completed.
+    let until = until + 1;
+    assert!(!advance(
+        &mut app,
+        &mut progress,
+        until,
+        1,
+        || false,
+        |_| {}
+    ));
+}

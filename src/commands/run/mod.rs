@@ -73,7 +73,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
                 // Nothing was run: every output is left as it was.
                 let signal = interrupts.raised().unwrap_or_default();
                 say(format_args!(
-                    "interrupted by signal {signal} while placing circles; nothing written"
+                    "interrupted by signal {signal} while placing or spawning circles; nothing written"
                 ));
                 return Ok(Finished::Interrupted { signal });
             };

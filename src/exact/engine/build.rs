@@ -87,8 +87,9 @@ impl EventEngine {
     }
 
     /// [`EventEngine::new`], or [`EventEngine::falling`] under `gravity`, with each circle's
-    /// `layers` (empty: every pair meets, [`EventEngine::set_layers`]), asking `stop` every
-    /// [`STOP_POLL_CIRCLES`] predictions whether to give up: `None` when it did. A build of
+    /// `layers` (empty: every pair meets, [`EventEngine::set_layers`]), asking `stop` as its
+    /// tables fill and every [`STOP_POLL_CIRCLES`] predictions whether to give up: `None` when
+    /// it did. A build of
     /// millions of circles takes seconds, which a signal must not wait for.
     pub fn build_until(
         circles: &[CircleState],

@@ -55,9 +55,9 @@ impl EventEngine {
 
     /// [`EventEngine::drift_to`] without the cells and predictions that make the engine
     /// go on: what is left is read ([`EventEngine::position`], [`EventEngine::velocity`]) and
-    /// thrown away. A stopped run's last step ends so, in O(N) however many circles there are,
+    /// thrown away; advanced again, it would follow stale events. A stopped run's last step ends so, in O(N) however many circles there are,
     /// where predicting millions of circles again takes seconds.
-    pub fn fly_unpredicted_to(&mut self, t: f64) {
+    pub(crate) fn fly_unpredicted_to(&mut self, t: f64) {
         let arena = self.arena;
         let scale = 1.0 + self.growth * t;
         for i in 0..self.len() {
