@@ -25,25 +25,24 @@ pub fn overlapping_circles(
     arena: &Arena,
     layers: &[CollisionLayers],
 ) -> Vec<(usize, usize, f64)> {
-    pairs_that_meet(circles, arena, layers)
-        .map(|(i, j)| {
-            let ((p, r), (q, s)) = (circles[i], circles[j]);
-            (i, j, r + s - arena.offset(p, q).length())
-        })
-        .collect()
+    overlaps_sorted(circles, arena, layers).collect()
 }
 
-/// The overlapping pairs of `circles` that meet under `layers`, sorted.
-fn pairs_that_meet(
-    circles: &[(DVec2, f64)],
-    arena: &Arena,
+/// [`overlapping_circles`] one pair at a time, without listing the depths.
+fn overlaps_sorted<'a>(
+    circles: &'a [(DVec2, f64)],
+    arena: &'a Arena,
     layers: &[CollisionLayers],
-) -> impl Iterator<Item = (usize, usize)> {
+) -> impl Iterator<Item = (usize, usize, f64)> + 'a {
     let mut pairs = Vec::new();
     overlapping_pairs(&mut CellList::default(), arena, circles, &mut pairs);
     pairs.retain(|&(i, j)| pair_meets(layers, i as usize, j as usize));
     pairs.sort_unstable();
-    pairs.into_iter().map(|(i, j)| (i as usize, j as usize))
+    pairs.into_iter().map(|(i, j)| {
+        let (i, j) = (i as usize, j as usize);
+        let ((p, r), (q, s)) = (circles[i], circles[j]);
+        (i, j, r + s - arena.offset(p, q).length())
+    })
 }
 
 /// Overlaps in one or more states, each as a fraction of the pair's smaller radius.
@@ -63,9 +62,8 @@ impl Overlaps {
     pub fn measure(circles: &[(DVec2, f64)], arena: &Arena, layers: &[CollisionLayers]) -> Self {
         let mut overlaps = Self::default();
         // Summed in the sorted pairs' order, whatever order the broad phase found them in.
-        for (i, j) in pairs_that_meet(circles, arena, layers) {
-            let ((p, r), (q, s)) = (circles[i], circles[j]);
-            let fraction = (r + s - arena.offset(p, q).length()) / r.min(s);
+        for (i, j, depth) in overlaps_sorted(circles, arena, layers) {
+            let fraction = depth / circles[i].1.min(circles[j].1);
             overlaps.pairs += 1;
             overlaps.max = overlaps.max.max(fraction);
             overlaps.sum += fraction;
