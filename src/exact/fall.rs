@@ -209,6 +209,29 @@ mod tests {
     }
 
     #[test]
+    fn a_vanishing_gravity_meets_a_peg_when_the_straight_line_does() {
+        // The checkpoint campaign's `swept` find: a circle falling at 0.81 onto a peg 0.012
+        // away under g = 1.8e-136. The quartic's top coefficients (g², g·v) are hundreds of
+        // orders below the rest, its turning points 10¹³⁵ away: the root search once stopped
+        // there, the hit was missed and the circle sank 0.2 % of its radius into the peg.
+        let (p, v) = (
+            DVec2::new(0.20374394109042002, 0.4495482472869555),
+            DVec2::new(8.66478600110202e-309, -0.8125),
+        );
+        let sigma = 0.2 + 0.2817738302337065;
+        let straight = falling_pair_time(-p, -v, DVec2::ZERO, sigma, f64::INFINITY).unwrap();
+        for g in [1.786e-136, 1e-300, 1e-60, 1e-20] {
+            for horizon in [0.016666667, f64::INFINITY] {
+                let t = falling_pair_time(-p, -v, DVec2::new(0.0, -g), sigma, horizon);
+                assert!(
+                    t.is_some_and(|t| (t - straight).abs() <= 1e-12 * straight),
+                    "g = {g:e}, horizon {horizon}: {t:?}, straight {straight}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn a_parabola_that_passes_beside_a_peg_never_meets_it() {
         // Dropped 2 to the side of the peg: straight down, never within 1.
         let t = falling_pair_time(

@@ -179,24 +179,33 @@ fn monotonic_root(d: &[f64; 4], a: f64, b: f64, guess: f64) -> f64 {
     let slope = [d[1], 2.0 * d[2], 3.0 * d[3]];
     let below = horner(d, a) < 0.0;
     let value = |t: f64| (horner(d, t), horner(&slope, t));
-    bracketed_newton(value, |g| (g < 0.0) == below, (a, b), guess, 200).0
+    bracketed_newton(value, |g| (g < 0.0) == below, (a, b), guess).0
 }
 
+/// Newton steps a root search takes before it only bisects (see [`bracketed_newton`]): from a
+/// good start a root is found in under ten.
+const NEWTON_STEPS: u32 = 40;
+
 /// Newton steps on `value` (its value and slope at a point) from `start`, kept inside the
-/// bracket `(a, b)` as it shrinks (bisection whenever a step would leave it), for at most
-/// `steps` steps or until a step lands on an end: a point moves the end `a` when `on_a_side`
-/// says its value is on `a`'s side of zero, else the end `b`. Newton converging from one side
-/// stops moving; the number next to it then decides, so the bracket ends two numbers wide
-/// in a few steps more. Returns the final bracket.
+/// bracket `(a, b)` as it shrinks (bisection whenever a step would leave it), until a step
+/// lands on an end: a point moves the end `a` when `on_a_side` says its value is on `a`'s side
+/// of zero, else the end `b`. Newton converging from one side stops moving; the number next to
+/// it then decides, so the bracket ends two numbers wide in a few steps more. Returns the final
+/// bracket.
+///
+/// A start far from the root on a polynomial whose coefficients span hundreds of orders of
+/// magnitude (a vanishing gravity) makes Newton crawl, halving a bracket 10¹³⁵ wide per step.
+/// After [`NEWTON_STEPS`] the search bisects the numbers themselves ([`split`]), which ends
+/// two numbers wide in at most 64 more steps whatever the scale.
 fn bracketed_newton(
     value: impl Fn(f64) -> (f64, f64),
     on_a_side: impl Fn(f64) -> bool,
     (mut a, mut b): (f64, f64),
     start: f64,
-    steps: u32,
 ) -> (f64, f64) {
     let mut t = start;
-    for _ in 0..steps {
+    // Each split halves the numbers left (at most 2⁶⁴, one more for a bracket across zero).
+    for step in 1..=NEWTON_STEPS + 66 {
         let (ft, slope) = value(t);
         if on_a_side(ft) {
             a = t;
@@ -204,7 +213,9 @@ fn bracketed_newton(
             b = t;
         }
         let newton = t - ft / slope;
-        t = if newton > a && newton < b && newton.is_finite() {
+        t = if step >= NEWTON_STEPS {
+            split(a, b)
+        } else if newton > a && newton < b && newton.is_finite() {
             newton
         } else if newton == t {
             // Converged from one side: the next number towards the other end settles which
@@ -220,6 +231,20 @@ fn bracketed_newton(
     (a, b)
 }
 
+/// The middle number of `[a, b]` as the numbers are laid out, not as they are spaced: halfway
+/// between their bit patterns (zero splits a bracket across it), so that each split halves
+/// how many numbers are left. An end when no number lies between them.
+fn split(a: f64, b: f64) -> f64 {
+    if a < 0.0 && b > 0.0 {
+        0.0
+    } else if b <= 0.0 {
+        -split(-b, -a)
+    } else {
+        // Both finite or `b` infinite: the sum of two patterns below 0x7FF1… fits.
+        f64::from_bits((a.max(0.0).to_bits() + b.to_bits()) / 2)
+    }
+}
+
 /// The first `τ` in `[a, b]` where the polynomial `c`, `fa > 0` at `a` and `fb ≤ 0` at `b` and
 /// monotonic between, reaches zero: Newton steps from where the chord between the ends
 /// crosses zero, kept inside a shrinking bracket (bisection whenever a step would leave it),
@@ -230,7 +255,7 @@ fn refine(c: &[f64; 5], (a, fa): (f64, f64), (b, fb): (f64, f64)) -> f64 {
     let value = |t: f64| (horner(c, t), horner(&d, t));
     let secant = a + fa * (b - a) / (fa - fb);
     let start = if secant > a && secant < b { secant } else { a };
-    bracketed_newton(value, |f| f > 0.0, (a, b), start, 100).1
+    bracketed_newton(value, |f| f > 0.0, (a, b), start).1
 }
 
 #[cfg(test)]
@@ -264,7 +289,7 @@ mod tests {
                 calls.set(calls.get() + 1);
                 (horner(&d, t), horner(&slope, t))
             };
-            let (a, b) = bracketed_newton(value, |g| g < 0.0, (0.0, 1e6), guess, 200);
+            let (a, b) = bracketed_newton(value, |g| g < 0.0, (0.0, 1e6), guess);
             assert_eq!(a.next_up(), b, "{d:?}: [{a}, {b}]");
             assert!(horner(&d, a) < 0.0 && horner(&d, b) >= 0.0, "{d:?}");
             assert!(
@@ -273,6 +298,26 @@ mod tests {
                 calls.get()
             );
         }
+    }
+
+    #[test]
+    fn a_root_far_from_the_start_is_found_in_a_bounded_number_of_steps() {
+        // τ² − 1 bracketed by (0, 10³⁰⁰) from 10³⁰⁰: Newton halves τ per step and would need
+        // a thousand; bisecting the numbers ends on the root's two numbers in about a hundred.
+        let d = [-1.0, 0.0, 1.0, 0.0];
+        let calls = std::cell::Cell::new(0);
+        let value = |t: f64| {
+            calls.set(calls.get() + 1);
+            (horner(&d, t), 2.0 * t)
+        };
+        let (a, b) = bracketed_newton(value, |g| g < 0.0, (0.0, 1e300), 1e300);
+        assert_eq!((a.next_up(), b), (b, 1.0), "[{a}, {b}]");
+        assert!(calls.get() <= NEWTON_STEPS + 66, "{} steps", calls.get());
+        // Across zero and below it, split halves the numbers between the ends.
+        assert_eq!(split(-1.0, 1.0), 0.0);
+        assert_eq!(split(-4.0, -1.0), -2.0);
+        assert_eq!(split(1.0, 1.0f64.next_up()), 1.0);
+        assert_eq!(split(1.0, 4.0), 2.0);
     }
 
     #[test]
