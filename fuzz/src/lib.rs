@@ -288,25 +288,32 @@ fn run(config: &CirclesConfig, solver: Solver) -> (Report, bool) {
 /// circle crossing a 4 × 4 box 10²⁷ times a step). Speeds are bounded by the fastest circle's
 /// and the speed the kinetic energy and a fall across the arena could give the lightest one,
 /// with [`RESOLUTION_MARGIN`] to spare; a run of ordinary speeds is a million times inside it.
+/// Where hits are rough or have friction, spin turns into motion, so the fastest surface and
+/// the energy of turning count too (a circle spinning at 10³⁰ per second sent its neighbour
+/// across the box at 10²⁸ in one rough hit: the campaign's `exact` find).
 fn resolvable(app: &mut bevy::app::App, dt: f64) -> bool {
     let circles = snapshot(app.world_mut());
     let world = app.world();
     let arena = world.resource::<Arena>();
-    let gravity = world
-        .resource::<Effects>()
-        .gravity
-        .map_or(0.0, |g| g.length());
+    let effects = world.resource::<Effects>();
+    let gravity = effects.gravity.map_or(0.0, |g| g.length());
+    let spin_moves = effects.is_rough() || effects.has_friction();
+    let turning = |c: &CircleState| if spin_moves { c.angular_velocity } else { 0.0 };
     let horizon = world.resource::<StepTotals>().sim_seconds + dt * SIMULATED_STEPS as f64;
     let movable = circles.iter().filter(|c| c.inv_mass() > 0.0);
+    // Each a uniform disc, as a resumed checkpoint's circles are: ½ m v² + ¼ m r² ω².
     let kinetic: f64 = movable
         .clone()
-        .map(|c| 0.5 * c.velocity.length_squared() / c.inv_mass())
+        .map(|c| {
+            let surface = turning(c) * c.radius;
+            (0.5 * c.velocity.length_squared() + 0.25 * surface * surface) / c.inv_mass()
+        })
         .sum();
     let lightest = movable.map(|c| c.inv_mass()).fold(0.0, f64::max);
     let fall = 2.0 * gravity * arena.size().max_element();
     let fastest = circles
         .iter()
-        .map(|c| c.velocity.length())
+        .map(|c| c.velocity.length() + (turning(c) * c.radius).abs())
         .fold(0.0, f64::max);
     let speed = fastest.max((2.0 * kinetic * lightest + fall).sqrt());
     let smallest = circles
