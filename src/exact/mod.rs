@@ -187,6 +187,10 @@ fn continuous_step(
         own,
         &mut circles,
     );
+    if state.engine.is_none() {
+        // A stop gave up the build: this step moves, turns and wakes nothing.
+        return;
+    }
     advance_engine(
         (*solver, dt.0, *budget, stop.as_deref()),
         &mut state,

@@ -360,6 +360,55 @@ fn a_step_a_stop_request_ends_is_not_kept_and_the_run_goes_on_from_where_it_stop
 }
 
 #[test]
+fn a_step_whose_build_a_stop_gave_up_moves_turns_and_wakes_nothing() {
+    use moving_circles::schedule::StopRequest;
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+    // Three circles at rest on the floor (asleep after the first step) and one spinning in the
+    // air with a restitution of its own; a stop raised before a step that builds its engine
+    // (`swept` always, `exact` once that circle lost its restitution) gives up the build:
+    // nothing moves, not even the spin (once turned by the smooth circles' own rule), and the
+    // count asleep stands.
+    let scene = r#"(arena: (size: (4.0, 4.0)), effects: (gravity: (0.0, -9.81), restitution: 0.5),
+        mass: Equal(1.0), circles: [
+            (position: (-1.0, -1.75), radius: 0.25), (position: (0.0, -1.75), radius: 0.25),
+            (position: (1.0, -1.75), radius: 0.25),
+            (position: (0.0, 1.0), radius: 0.25, velocity: (1.0, 0.0), angular_velocity: 5.0),
+        ])"#;
+    for solver in [Solver::Swept, Solver::Exact] {
+        let config = Scene::parse(scene, "stop.ron")
+            .and_then(|s| s.to_config("stop.ron"))
+            .unwrap();
+        let mut app = create_app(CirclesConfig { solver, ..config });
+        let world = app.world_mut();
+        let mut spinning = world.query::<(Entity, &AngularVelocity)>();
+        let (spinner, _) = spinning.iter(world).find(|(_, w)| w.0 != 0.0).unwrap();
+        world.entity_mut(spinner).insert(Restitution(0.5));
+        step(&mut app, 2);
+        let state = |app: &mut App| {
+            let world = app.world_mut();
+            let asleep = world.resource::<Sleeping>().count;
+            let mut circles = world.query::<(&Position, &Velocity, &Rotation)>();
+            let circles: Vec<_> = circles
+                .iter(world)
+                .map(|(p, v, a)| (p.0, v.0, a.0))
+                .collect();
+            (circles, asleep)
+        };
+        let before = state(&mut app);
+        assert_eq!(before.1, 3, "{solver}: the floor's circles sleep");
+        app.world_mut().entity_mut(spinner).remove::<Restitution>();
+        app.insert_resource(StopRequest(Arc::new(AtomicBool::new(true))));
+        step(&mut app, 1);
+        assert_eq!(
+            state(&mut app),
+            before,
+            "{solver}: the given-up step changed the circles"
+        );
+    }
+}
+
+#[test]
 fn a_stop_raised_during_the_last_step_is_reported_as_ending_the_run() {
     use moving_circles::run::{Progress, advance};
     use moving_circles::schedule::StepTotals;
