@@ -14,8 +14,6 @@ pub struct CellList {
     pub(super) start: Vec<u32>,
     pub(super) order: Vec<u32>,
     cell_of: Vec<u32>,
-    /// Next free slot per cell while filling `order`.
-    cursor: Vec<u32>,
     /// Centres and reaches in `order`, reused by the translated single-grid scan.
     pub(super) sorted: Vec<(DVec2, f64)>,
 }
@@ -123,15 +121,18 @@ impl CellList {
         let placed = self.start[cells] as usize;
         self.order.clear();
         self.order.resize(placed, 0);
-        self.cursor.clear();
-        self.cursor.extend_from_slice(&self.start[..cells]);
-        for (i, &c) in self.cell_of.iter().enumerate() {
+        // `start[c + 1]` is where cell `c` ends: filled from the back, each cell's circles end
+        // up in input order and `start[c + 1]` where the cell begins, one place late (so no
+        // cursor per cell, a table as large as `start`, is needed).
+        for (i, &c) in self.cell_of.iter().enumerate().rev() {
             if c != NO_CELL {
-                let slot = &mut self.cursor[c as usize];
+                let slot = &mut self.start[c as usize + 1];
+                *slot -= 1;
                 self.order[*slot as usize] = i as u32;
-                *slot += 1;
             }
         }
+        self.start.copy_within(1..=cells, 0);
+        self.start[cells] = placed as u32;
     }
 
     /// Calls `visit(k)` for every circle (as its position `k` in the cell order) in the cells

@@ -222,6 +222,44 @@ mod tests {
     }
 
     #[test]
+    fn the_bands_folded_hold_the_listed_pairs_in_the_listed_order() {
+        // Serial (few circles) and on all cores: the bands, joined in row order, hold exactly
+        // the pairs `overlapping_pairs` lists, in its order, so what is folded per band and
+        // the order the bands are added in do not depend on the threads.
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        for n in [300, 3 * PARALLEL_FROM] {
+            let side = (n as f64 / 3.0).sqrt();
+            let circles: Vec<(DVec2, f64)> = (0..n)
+                .map(|_| {
+                    let p = DVec2::new(rng.random_range(0.0..side), rng.random_range(0.0..side));
+                    (p, rng.random_range(0.05..0.3))
+                })
+                .collect();
+            for arena in [
+                Arena::default(),
+                periodic_arena(DVec2::ZERO, DVec2::splat(side)),
+            ] {
+                let mut listed = Vec::new();
+                overlapping_pairs(&mut CellList::default(), &arena, &circles, &mut listed);
+                let r_max = radius_range(&circles).1;
+                let fold = |band: &mut Vec<(u32, u32)>, (i, j): (usize, usize), (a, b)| {
+                    assert_eq!((a, b), (circles[i], circles[j]));
+                    band.push((i as u32, j as u32));
+                };
+                let bands = scan::fold_pairs_by_band(&arena, &circles, r_max, Vec::new, fold);
+                let bands = bands.expect("a grid many cells wide");
+                assert!(listed.len() > 100, "{}", listed.len());
+                assert!(
+                    n < PARALLEL_FROM || bands.len() > 1,
+                    "{} bands",
+                    bands.len()
+                );
+                assert_eq!(bands.concat(), listed, "n = {n}, {arena:?}");
+            }
+        }
+    }
+
+    #[test]
     fn radii_spanning_decades_find_exactly_the_brute_force_pairs() {
         let mut rng = ChaCha8Rng::seed_from_u64(10);
         for periodic in [false, true] {

@@ -26,19 +26,8 @@ pub fn pairs_in_cell_order(
     sorted: &mut Vec<(DVec2, f64)>,
     pairs: &mut Vec<(u32, u32)>,
 ) {
-    if arena.is_periodic() {
-        cells.rebuild_periodic(circles, arena.min, arena.size(), 2.0 * max_radius);
-    } else {
-        cells.rebuild(circles, 2.0 * max_radius);
-    }
+    bin_in_cell_order(cells, arena, circles, max_radius, sorted);
     let start = pairs.len();
-    sorted.clear();
-    sorted.resize(cells.order.len(), (DVec2::ZERO, 0.0));
-    map_chunks(sorted, |from, out| {
-        for (slot, &i) in out.iter_mut().zip(&cells.order[from..]) {
-            *slot = circles[i as usize];
-        }
-    });
     let rows = cells.grid.rows;
     if circles.len() >= PARALLEL_FROM {
         let pool = ComputeTaskPool::get_or_init(TaskPool::default);
@@ -65,6 +54,77 @@ pub fn pairs_in_cell_order(
     if cells.wraps_onto_itself() {
         sort_and_dedupe(pairs, start);
     }
+}
+
+/// Buckets `circles` into `cells` (one largest diameter wide) and copies them into `sorted` in
+/// cell order.
+fn bin_in_cell_order(
+    cells: &mut CellList,
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    max_radius: f64,
+    sorted: &mut Vec<(DVec2, f64)>,
+) {
+    if arena.is_periodic() {
+        cells.rebuild_periodic(circles, arena.min, arena.size(), 2.0 * max_radius);
+    } else {
+        cells.rebuild(circles, 2.0 * max_radius);
+    }
+    sorted.clear();
+    sorted.resize(cells.order.len(), (DVec2::ZERO, 0.0));
+    map_chunks(sorted, |from, out| {
+        for (slot, &i) in out.iter_mut().zip(&cells.order[from..]) {
+            *slot = circles[i as usize];
+        }
+    });
+}
+
+/// Rows of cells per band of [`fold_pairs_by_band`]: a fixed number, so that which pairs are
+/// folded together, and in what order, does not depend on the number of threads.
+const BAND_ROWS: usize = 16;
+
+/// Folds every overlapping pair of `circles` (centre, reach), as input indices `(i, j)` with
+/// `i < j` and the two circles (read in cell order, near each other in memory), into one value per band of [`BAND_ROWS`] rows of the single-level grid (pairs in
+/// scan order within a band), the bands on all cores for large inputs, without listing the
+/// pairs; returns the bands' values in row order, the same whatever the number of threads.
+/// `None` where the grid is too coarse for each pair to come once (a periodic arena a few
+/// cells wide): the caller lists the pairs instead.
+pub fn fold_pairs_by_band<T: Send + 'static>(
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    max_radius: f64,
+    empty: impl Fn() -> T + Sync,
+    fold: impl Fn(&mut T, (usize, usize), ((DVec2, f64), (DVec2, f64))) + Sync,
+) -> Option<Vec<T>> {
+    let (mut cells, mut sorted) = (CellList::default(), Vec::new());
+    bin_in_cell_order(&mut cells, arena, circles, max_radius, &mut sorted);
+    if cells.wraps_onto_itself() {
+        return None;
+    }
+    let (cells, sorted) = (&cells, &sorted);
+    let band = |rows: std::ops::Range<usize>| {
+        let mut value = empty();
+        let _ = visit_rows(cells, sorted, arena, rows, &mut |k, l| {
+            let (k, l) = (k as usize, l as usize);
+            let (i, j) = (cells.order[k] as usize, cells.order[l] as usize);
+            fold(&mut value, (i, j), (sorted[k], sorted[l]));
+            ControlFlow::Continue(())
+        });
+        value
+    };
+    let rows = cells.grid.rows;
+    let bands =
+        (0..rows.div_ceil(BAND_ROWS)).map(|b| b * BAND_ROWS..((b + 1) * BAND_ROWS).min(rows));
+    if circles.len() < PARALLEL_FROM {
+        return Some(bands.map(band).collect());
+    }
+    let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+    let band = &band;
+    Some(pool.scope(|scope| {
+        for rows in bands {
+            scope.spawn(async move { band(rows) });
+        }
+    }))
 }
 
 /// [`pairs_in_cell_order`] with the pairs translated back to input indices.
