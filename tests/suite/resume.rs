@@ -399,3 +399,116 @@ fn a_resumed_exact_run_goes_on_with_the_engine_it_kept() {
         "the restored engine was kept: every circle is seen as changed once, and found equal"
     );
 }
+
+/// What a game-side reader heard: each hit with the step it came in, its circles as their
+/// places in spawn order, and its numbers' bits.
+#[derive(bevy::prelude::Resource, Default)]
+struct Heard(Vec<(u64, String)>);
+
+fn listen(
+    totals: bevy::prelude::Res<moving_circles::schedule::StepTotals>,
+    mut heard: bevy::prelude::ResMut<Heard>,
+    mut circle_hits: bevy::prelude::MessageReader<moving_circles::hits::CircleHit>,
+    mut wall_hits: bevy::prelude::MessageReader<moving_circles::hits::WallHit>,
+    circles: bevy::prelude::Query<
+        bevy::prelude::Entity,
+        bevy::prelude::With<moving_circles::prelude::Radius>,
+    >,
+) {
+    let place = |e| circles.iter().position(|c| c == e).unwrap();
+    let step = totals.steps;
+    for h in circle_hits.read() {
+        let bits = [
+            h.point.x,
+            h.point.y,
+            h.normal.x,
+            h.impulse,
+            h.normal_speed,
+            h.time,
+        ]
+        .map(f64::to_bits);
+        heard
+            .0
+            .push((step, format!("pair {} {} {bits:?}", place(h.a), place(h.b))));
+    }
+    for h in wall_hits.read() {
+        let bits = [h.point.x, h.point.y, h.impulse, h.normal_speed, h.time].map(f64::to_bits);
+        heard.0.push((
+            step,
+            format!("wall {} {:?} {} {bits:?}", place(h.circle), h.wall, h.count),
+        ));
+    }
+}
+
+#[test]
+fn a_kinematic_circle_and_the_hit_messages_resume_bit_for_bit_under_every_solver() {
+    use bevy::prelude::*;
+    use moving_circles::checkpoint::Checkpoint;
+    use moving_circles::circle::snapshot;
+    use moving_circles::prelude::*;
+    use moving_circles::run::{Progress, headless_app};
+    // A walled gas whose first circle is made kinematic by code (immovable, flying on at the
+    // velocity it has), with hit messages on: paused at step 25 and resumed, it ends where the
+    // whole run ends and a reader hears the same hits after the pause.
+    let scene = "(arena: (size: (8.0, 6.0), boundary: walls),
+        effects: (collisions: true, hit_messages: true, restitution: 0.9),
+        spawn: (count: 40, radius: (0.15, 0.3), speed: (2.0, 6.0), seed: 7))";
+    let config = Scene::parse(scene, "k.ron")
+        .and_then(|s| s.to_config("k.ron"))
+        .unwrap();
+    let listening = |mut app: App| {
+        app.init_resource::<Heard>().add_systems(Update, listen);
+        app
+    };
+    for solver in [
+        Solver::Discrete,
+        Solver::Substeps(4),
+        Solver::Soft(4),
+        Solver::Swept,
+        Solver::Exact,
+    ] {
+        let mut whole = listening(headless_app(CirclesConfig {
+            solver,
+            ..config.clone()
+        }));
+        let world = whole.world_mut();
+        let first = world
+            .query_filtered::<Entity, With<Radius>>()
+            .iter(world)
+            .next()
+            .unwrap();
+        world.entity_mut(first).insert(Mass::IMMOVABLE);
+        for _ in 0..25 {
+            whole.update();
+        }
+        let progress = Progress::start(whole.world_mut());
+        let bytes = Checkpoint::take(whole.world_mut(), "k", &progress).to_bytes();
+        let (resumed, _) = Checkpoint::from_bytes(&bytes, "k")
+            .unwrap()
+            .resume("k")
+            .unwrap();
+        let mut resumed = listening(resumed);
+        for _ in 0..35 {
+            whole.update();
+            resumed.update();
+        }
+        let what = format!("{solver}");
+        assert_eq!(
+            snapshot(whole.world_mut()),
+            snapshot(resumed.world_mut()),
+            "{what}"
+        );
+        let heard = |app: &App| app.world().resource::<Heard>().0.clone();
+        let after: Vec<_> = heard(&whole)
+            .into_iter()
+            .filter(|(step, _)| *step > 25)
+            .collect();
+        assert!(after.len() > 20, "{what}: {} hits heard", after.len());
+        assert_eq!(after, heard(&resumed), "{what}");
+        let paddle = snapshot(resumed.world_mut())[0];
+        assert!(
+            paddle.mass.is_infinite() && paddle.velocity != bevy::math::DVec2::ZERO,
+            "{what}"
+        );
+    }
+}
