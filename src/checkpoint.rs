@@ -31,9 +31,10 @@ use crate::segment::Segments;
 use crate::sleep::Sleeping;
 use crate::soft::{CacheSnapshot, SoftState};
 use crate::spawn::{Dropped, SpawnReport};
+use own::OwnParts;
 
 /// The first field of every checkpoint: what it is and the layout's version.
-const FORMAT: &str = "moving_circles checkpoint 7";
+const FORMAT: &str = "moving_circles checkpoint 8";
 /// Most bytes a checkpoint may have: the most circles an input may ask for, each with its
 /// engine state, fit.
 pub const MAX_CHECKPOINT_BYTES: u64 = 2 << 30;
@@ -66,6 +67,9 @@ pub struct Checkpoint {
     engine: Option<EngineSnapshot>,
     /// The `soft` solver's contacts and impulses, for warm starting.
     contacts: Option<CacheSnapshot>,
+    /// What circles have of their own that code gave them (restitution, friction, inertia,
+    /// layers, sensors), for those that have any.
+    own: Vec<OwnParts>,
 }
 
 impl Checkpoint {
@@ -129,6 +133,7 @@ impl Checkpoint {
             },
             engine,
             contacts,
+            own: own::gather(world, &entities),
         }
     }
 
@@ -299,6 +304,7 @@ impl Checkpoint {
                 self.steps.sim_seconds, self.steps.steps, self.dt
             ));
         }
+        own::check(&self.own, self.circles.len())?;
         // No engine under `exact` is a build a signal stopped: the next step builds one.
         if self.engine.is_some() && self.solver != Solver::Exact {
             return Err("the engine state does not match the solver".to_owned());
@@ -360,6 +366,8 @@ impl Checkpoint {
                 "its circles did not come back as they were written",
             ));
         }
+        let entities: Vec<Entity> = circles.iter().map(|&(e, _)| e).collect();
+        own::apply(&self.own, world, &entities);
         for (&(entity, _), &sleep) in circles.iter().zip(&self.sleep) {
             if let Some(mut kept) = world.get_mut::<Sleep>(entity) {
                 *kept = sleep;
@@ -367,7 +375,6 @@ impl Checkpoint {
         }
         world.resource_mut::<Sleeping>().count = self.sleep.iter().filter(|s| s.asleep).count();
         if let Some(contacts) = &self.contacts {
-            let entities: Vec<Entity> = circles.iter().map(|&(e, _)| e).collect();
             world
                 .resource_mut::<SoftState>()
                 .restore(contacts, &entities)
@@ -376,13 +383,17 @@ impl Checkpoint {
         let mut state = world.resource_mut::<EngineState>();
         state.budget_exhausted = self.budget_exhausted;
         if let Some(engine) = self.engine {
+            let restitutions =
+                own::restitutions(&self.own, circles.len(), self.effects.restitution);
+            let setup = (self.arena, self.effects, &self.segments, restitutions);
             state
-                .restore(engine, &circles, (self.arena, self.effects, &self.segments))
+                .restore(engine, &circles, setup)
                 .map_err(|message| InputError::whole(origin, message))?;
         }
         Ok((app, self.progress))
     }
 }
 
+mod own;
 #[cfg(test)]
 mod tests;

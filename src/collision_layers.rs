@@ -38,7 +38,18 @@ use crate::components::{Position, Radius};
 /// ([`CollisionLayers::meets`]). A circle without this component is in group 0 alone and meets
 /// every group ([`CollisionLayers::DEFAULT`]), so a team in other groups that leaves group 0
 /// out of its filters passes through every plain circle.
-#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(
+    Component,
+    Reflect,
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    serde::Serialize,
+    serde::Deserialize,
+)]
 #[reflect(Component, Default, Debug)]
 pub struct CollisionLayers {
     /// The groups this circle is in.

@@ -84,3 +84,51 @@ fn a_clock_that_is_not_its_steps_is_refused() {
         assert!(error.contains("its clock"), "{error}");
     }
 }
+
+#[test]
+fn parts_of_their_own_out_of_range_or_order_are_refused() {
+    use crate::collision_layers::Sensor;
+    use crate::components::{Friction, Inertia, Restitution};
+    let mut config = CirclesConfig::default();
+    config.spawn.count = 8;
+    let mut app = headless_app(config);
+    let world = app.world_mut();
+    let circles: Vec<Entity> = world
+        .query_filtered::<Entity, With<crate::components::Radius>>()
+        .iter(world)
+        .collect();
+    world
+        .entity_mut(circles[1])
+        .insert((Restitution(0.5), Friction(0.2)));
+    world.entity_mut(circles[4]).insert((Inertia(0.01), Sensor));
+    app.update();
+    let progress = Progress::start(app.world_mut());
+    let good = Checkpoint::take(app.world_mut(), "t", &progress);
+    assert_eq!(good.own.len(), 2, "{:?}", good.own);
+    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    let refused = |edit: &dyn Fn(&mut Checkpoint), says: &str| {
+        let mut bad = good.clone();
+        edit(&mut bad);
+        let error = Checkpoint::from_bytes(&bad.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains(says), "{says}: {error}");
+    };
+    refused(
+        &|c| c.own[0].restitution = Some(1.5),
+        "own restitution is 1.5",
+    );
+    refused(&|c| c.own[0].friction = Some(-0.1), "own friction");
+    refused(
+        &|c| c.own[1].inertia = Some(f64::NAN),
+        "own moment of inertia",
+    );
+    refused(&|c| c.own[1].circle = 8, "out of order or range");
+    assert!(good.own[1].sensor.is_some(), "{:?}", good.own);
+    refused(&|c| c.own.swap(0, 1), "out of order or range");
+    let sensor = good.own[1].circle;
+    let says = format!("sensor circle {sensor} overlaps");
+    refused(&|c| c.own[1].sensor = Some(vec![sensor]), &says);
+    let (a, b) = ((sensor + 1) % 8, (sensor + 2) % 8);
+    refused(&|c| c.own[1].sensor = Some(vec![a.max(b), a.min(b)]), &says);
+}

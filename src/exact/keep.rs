@@ -114,16 +114,15 @@ impl EngineState {
         Some(engine.snapshot())
     }
 
-    /// Puts back the `exact` engine of a checkpoint for `circles` (entities in the order of the
-    /// continuous step's query, states as the engine last wrote them), so that the next step
-    /// goes on with it instead of rebuilding.
+    /// Puts back the `exact` engine of a checkpoint for `circles` (entities in query order,
+    /// states as the engine last wrote them) under the world's arena, effects, segment walls and
+    /// restitutions (each circle's, if any has its own), so the next step goes on with it.
     pub fn restore(
         &mut self,
         snapshot: EngineSnapshot,
         circles: &[(Entity, CircleState)],
-        setup: (Arena, Effects, &Segments),
+        (arena, effects, segments, restitutions): (Arena, Effects, &Segments, Vec<f64>),
     ) -> Result<(), String> {
-        let (arena, effects, segments) = setup;
         let states: Vec<CircleState> = circles.iter().map(|&(_, c)| c).collect();
         let mut engine = EventEngine::restore(
             snapshot,
@@ -135,6 +134,7 @@ impl EngineState {
             roughness(&effects),
         )?;
         engine.record_hits(effects.hit_messages);
+        engine.set_own_restitutions(restitutions);
         if let Some(i) = (0..engine.len()).find(|&i| engine.position(i) != states[i].position) {
             return Err(format!(
                 "engine state of circle {i} puts it elsewhere than the circle"

@@ -540,9 +540,9 @@ fn a_sensor_sweeping_through_a_sleeping_heap_wakes_none_of_it() {
 
 #[test]
 fn a_checkpoint_of_an_exact_run_with_a_wide_sensor_resumes() {
-    // The engine's cells are sized without the sensor, and a checkpoint carries neither layers
-    // nor sensors: it keeps no engine, the resumed run builds one, and the zone comes back as
-    // a plain circle (a documented loss; before, the resume was refused as inconsistent).
+    // The engine's cells are sized without the sensor: the checkpoint keeps no engine, the
+    // resumed run builds one, and the zone comes back as a sensor (once it came back as a
+    // plain circle, and before that the resume was refused as inconsistent).
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let mut app = empty_box(Solver::Exact);
     spawn_bodies(
@@ -560,7 +560,7 @@ fn a_checkpoint_of_an_exact_run_with_a_wide_sensor_resumes() {
         .resume("zone.checkpoint")
         .unwrap_or_else(|e| panic!("our own checkpoint does not resume: {e}"));
     let world = resumed.world_mut();
-    assert_eq!(world.query::<&Sensor>().iter(world).count(), 0);
+    assert_eq!(world.query::<&Sensor>().iter(world).count(), 1);
     step(&mut resumed, 20);
     assert_eq!(
         resumed.world().resource::<CircleDiagnostics>().non_finite,

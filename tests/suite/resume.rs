@@ -440,19 +440,66 @@ fn listen(
     }
 }
 
-#[test]
-fn a_kinematic_circle_and_the_hit_messages_resume_bit_for_bit_under_every_solver() {
+/// What code gave each circle of its own, with where the circle is, in a fixed order (the
+/// order of a query depends on the components circles were given, and when).
+fn own_parts(world: &mut bevy::prelude::World) -> Vec<String> {
+    use moving_circles::collision_layers::{Sensor, SensorOverlaps};
+    use moving_circles::prelude::*;
+    let mut circles = world.query::<(
+        &Position,
+        Option<&Restitution>,
+        Option<&Friction>,
+        Option<&Inertia>,
+        Option<&CollisionLayers>,
+        Option<(&Sensor, &SensorOverlaps)>,
+    )>();
+    let mut parts: Vec<String> = circles
+        .iter(world)
+        .map(|(p, e, f, i, l, s)| {
+            let sensing = s.map(|s| s.1.circles().len());
+            format!(
+                "{:?} {e:?} {f:?} {i:?} {l:?} {sensing:?}",
+                p.0.to_array().map(f64::to_bits)
+            )
+        })
+        .collect();
+    parts.sort();
+    parts
+}
+
+/// A headless app of `config` under `solver` whose circles code changed before the first step:
+/// `made` is given each (its place in spawn order, the circle).
+fn made_app(
+    config: &moving_circles::config::CirclesConfig,
+    solver: moving_circles::config::Solver,
+    made: &impl Fn(usize, &mut bevy::ecs::world::EntityWorldMut),
+) -> bevy::prelude::App {
+    use bevy::prelude::*;
+    use moving_circles::prelude::*;
+    let mut app = moving_circles::run::headless_app(CirclesConfig {
+        solver,
+        ..config.clone()
+    });
+    let world = app.world_mut();
+    let circles: Vec<Entity> = world
+        .query_filtered::<Entity, With<Radius>>()
+        .iter(world)
+        .collect();
+    for (i, &e) in circles.iter().enumerate() {
+        made(i, &mut world.entity_mut(e));
+    }
+    app
+}
+
+/// Runs `scene` under every solver with `made` applied to its circles (in spawn order) by code
+/// before the first step, whole and paused at step 25 then resumed from the checkpoint, and
+/// asserts both end in the same state and that a reader hears the same hits after the pause.
+fn resumes_bit_for_bit(scene: &str, made: impl Fn(usize, &mut bevy::ecs::world::EntityWorldMut)) {
     use bevy::prelude::*;
     use moving_circles::checkpoint::Checkpoint;
     use moving_circles::circle::snapshot;
     use moving_circles::prelude::*;
-    use moving_circles::run::{Progress, headless_app};
-    // A walled gas whose first circle is made kinematic by code (immovable, flying on at the
-    // velocity it has), with hit messages on: paused at step 25 and resumed, it ends where the
-    // whole run ends and a reader hears the same hits after the pause.
-    let scene = "(arena: (size: (8.0, 6.0), boundary: walls),
-        effects: (collisions: true, hit_messages: true, restitution: 0.9),
-        spawn: (count: 40, radius: (0.15, 0.3), speed: (2.0, 6.0), seed: 7))";
+    use moving_circles::run::Progress;
     let config = Scene::parse(scene, "k.ron")
         .and_then(|s| s.to_config("k.ron"))
         .unwrap();
@@ -460,24 +507,8 @@ fn a_kinematic_circle_and_the_hit_messages_resume_bit_for_bit_under_every_solver
         app.init_resource::<Heard>().add_systems(Update, listen);
         app
     };
-    for solver in [
-        Solver::Discrete,
-        Solver::Substeps(4),
-        Solver::Soft(4),
-        Solver::Swept,
-        Solver::Exact,
-    ] {
-        let mut whole = listening(headless_app(CirclesConfig {
-            solver,
-            ..config.clone()
-        }));
-        let world = whole.world_mut();
-        let first = world
-            .query_filtered::<Entity, With<Radius>>()
-            .iter(world)
-            .next()
-            .unwrap();
-        world.entity_mut(first).insert(Mass::IMMOVABLE);
+    for solver in crate::common::EVERY_SOLVER {
+        let mut whole = listening(made_app(&config, solver, &made));
         for _ in 0..25 {
             whole.update();
         }
@@ -505,10 +536,90 @@ fn a_kinematic_circle_and_the_hit_messages_resume_bit_for_bit_under_every_solver
             .collect();
         assert!(after.len() > 20, "{what}: {} hits heard", after.len());
         assert_eq!(after, heard(&resumed), "{what}");
-        let paddle = snapshot(resumed.world_mut())[0];
+    }
+}
+
+#[test]
+fn a_kinematic_circle_and_the_hit_messages_resume_bit_for_bit_under_every_solver() {
+    use moving_circles::prelude::*;
+    // A walled gas whose first circle is made kinematic by code (immovable, flying on at the
+    // velocity it has), with hit messages on.
+    let scene = "(arena: (size: (8.0, 6.0), boundary: walls),
+        effects: (collisions: true, hit_messages: true, restitution: 0.9),
+        spawn: (count: 40, radius: (0.15, 0.3), speed: (2.0, 6.0), seed: 7))";
+    resumes_bit_for_bit(scene, |i, circle| {
+        if i == 0 {
+            circle.insert(Mass::IMMOVABLE);
+        }
+    });
+}
+
+#[test]
+fn what_code_gave_circles_of_their_own_is_kept_by_a_checkpoint_under_every_solver() {
+    use bevy::prelude::*;
+    use moving_circles::checkpoint::Checkpoint;
+    use moving_circles::collision_layers::Sensor;
+    use moving_circles::prelude::*;
+    use moving_circles::run::Progress;
+    // Rough hits with friction in a box under gravity: circles of their own restitution,
+    // friction and moment of inertia, a team in layers of its own, and a sensor. The resumed
+    // circles are where they were with the same parts (a sensor with as many overlaps), and
+    // keep them as the run goes on.
+    let scene = "(arena: (size: (8.0, 6.0), boundary: walls),
+        effects: (collisions: true, restitution: 0.9, gravity: (0.0, -3.0), friction: 0.3,
+                  tangential_restitution: 0.4),
+        spawn: (count: 40, radius: (0.15, 0.3), speed: (2.0, 6.0), seed: 8))";
+    let config = Scene::parse(scene, "own.ron")
+        .and_then(|s| s.to_config("own.ron"))
+        .unwrap();
+    let made = |i: usize, circle: &mut bevy::ecs::world::EntityWorldMut| {
+        match i % 8 {
+            0 => circle.insert(Restitution(0.3)),
+            1 => circle.insert(Friction(0.9)),
+            2 => circle.insert(Inertia(0.002)),
+            3 => circle.insert(CollisionLayers::new(0b10, 0b10)),
+            4 if i < 10 => circle.insert(Sensor),
+            _ => circle,
+        };
+    };
+    for solver in crate::common::EVERY_SOLVER {
+        let mut app = made_app(&config, solver, &made);
+        for _ in 0..25 {
+            app.update();
+        }
+        let progress = Progress::start(app.world_mut());
+        let kept = own_parts(app.world_mut());
         assert!(
-            paddle.mass.is_infinite() && paddle.velocity != bevy::math::DVec2::ZERO,
-            "{what}"
+            kept.iter()
+                .any(|p| p.ends_with("Some(1)") || p.ends_with("Some(0)"))
         );
+        let bytes = Checkpoint::take(app.world_mut(), "own", &progress).to_bytes();
+        let (mut resumed, _) = Checkpoint::from_bytes(&bytes, "own")
+            .unwrap()
+            .resume("own")
+            .unwrap();
+        assert_eq!(own_parts(resumed.world_mut()), kept, "{solver}");
+        for _ in 0..35 {
+            resumed.update();
+        }
+        // Which parts there are, wherever the circles went and whatever a sensor overlaps.
+        let kinds = |parts: &[String]| -> Vec<String> {
+            let mut kinds: Vec<String> = parts
+                .iter()
+                .map(|p| {
+                    p.split_once("] ")
+                        .unwrap()
+                        .1
+                        .rsplit_once(' ')
+                        .unwrap()
+                        .0
+                        .to_owned()
+                })
+                .collect();
+            kinds.sort();
+            kinds
+        };
+        let (before, after) = (kinds(&kept), kinds(&own_parts(resumed.world_mut())));
+        assert_eq!(after, before, "{solver}");
     }
 }
