@@ -1,6 +1,8 @@
 //! Checkpoints: the whole state of a headless run between two steps — the settings, every
 //! circle, the counters and clocks, what the report has gathered, and the `exact` engine with
-//! its pending events — so that `run --resume` goes on bit for bit as the run would have.
+//! its pending events, and what code gave circles of their own — so that `run --resume` goes
+//! on bit for bit as the run would have (a game whose circles gained components goes on from
+//! the same state, its circles perhaps in another query order: see `own`).
 //! Written by `run --checkpoint` through [`write_atomically`](crate::io::write_atomically) in
 //! a compact binary form (postcard); read back with a size limit and every value checked, so a
 //! damaged or forged file is an error naming the file, never a panic.
@@ -86,6 +88,7 @@ impl Checkpoint {
         let budget_exhausted = state.budget_exhausted;
         let (entities, circles): (Vec<Entity>, Vec<CircleState>) =
             with_entities.into_iter().unzip();
+        let own = own::gather(world, &entities);
         let contacts = match world.resource::<Solver>() {
             Solver::Soft(_) => world.resource::<SoftState>().snapshot(&entities),
             _ => None,
@@ -131,9 +134,11 @@ impl Checkpoint {
                 last_sample: None,
                 ..*progress
             },
-            engine,
+            // A restored engine has no layers: where circles have them it is not kept, and the
+            // resumed run builds one (as the next step would on seeing them changed).
+            engine: engine.filter(|_| own.iter().all(|p| p.layers.is_none())),
             contacts,
-            own: own::gather(world, &entities),
+            own,
         }
     }
 

@@ -141,7 +141,9 @@ impl Rotation {
 #[reflect(Component, Debug)]
 pub struct Inertia(pub f64);
 
-/// A circle's own friction coefficient (Coulomb's μ, 0 or more); without it a circle takes
+/// A circle's own friction coefficient (Coulomb's μ, from 0 to
+/// [`MAX_FRICTION`](crate::config::MAX_FRICTION), as the scene's: a checkpoint of a circle with
+/// more is refused when read back); without it a circle takes
 /// the scene's (`effects.friction` against circles, `effects.wall_friction` against walls).
 /// Two values meet as the scene's `effects.friction_combine` says (their geometric mean by
 /// default), against other circles and walls alike. Friction acts under the contact solver

@@ -9,9 +9,11 @@
 //!   runs, which libFuzzer mutates); what is accepted is resumed and run a few steps.
 
 use bevy::math::DVec2;
+use bevy::prelude::Entity;
 use moving_circles::arena::{Arena, Boundary};
 use moving_circles::checkpoint::Checkpoint;
-use moving_circles::circle::{CircleState, snapshot};
+use moving_circles::circle::{CircleState, inverse_inertia, snapshot_with_entities};
+use moving_circles::components::Inertia;
 use moving_circles::config::{CirclesConfig, Effects, MAX_CIRCLES, Solver};
 use moving_circles::error::InputError;
 use moving_circles::exact::{EXACT_EVENTS_PER_CIRCLE, EventBudget, SWEPT_EVENTS_PER_CIRCLE};
@@ -289,10 +291,12 @@ fn run(config: &CirclesConfig, solver: Solver) -> (Report, bool) {
 /// and the speed the kinetic energy and a fall across the arena could give the lightest one,
 /// with [`RESOLUTION_MARGIN`] to spare; a run of ordinary speeds is a million times inside it.
 /// Where hits are rough or have friction, spin turns into motion, so the fastest surface and
-/// the energy of turning count too (a circle spinning at 10³⁰ per second sent its neighbour
-/// across the box at 10²⁸ in one rough hit: the campaign's `exact` find).
+/// the energy of turning count too, through each circle's own moment of inertia (a circle
+/// spinning at 10³⁰ per second sent its neighbour across the box at 10²⁸ in one rough hit: the
+/// campaign's `exact` find); a spinning circle that never turns back (no inertia of its own to
+/// spend) drives its neighbours like a paddle without bound, so it is never resolvable.
 fn resolvable(app: &mut bevy::app::App, dt: f64) -> bool {
-    let circles = snapshot(app.world_mut());
+    let with_entities = snapshot_with_entities(app.world_mut());
     let world = app.world();
     let arena = world.resource::<Arena>();
     let effects = world.resource::<Effects>();
@@ -300,14 +304,24 @@ fn resolvable(app: &mut bevy::app::App, dt: f64) -> bool {
     let spin_moves = effects.is_rough() || effects.has_friction();
     let turning = |c: &CircleState| if spin_moves { c.angular_velocity } else { 0.0 };
     let horizon = world.resource::<StepTotals>().sim_seconds + dt * SIMULATED_STEPS as f64;
+    // ½ m v² + ½ I ω², with I the circle's own or a uniform disc's.
+    let energy = |(e, c): &(Entity, CircleState)| {
+        let w = turning(c);
+        let own = world.get::<Inertia>(*e).map(|i| i.0);
+        let inv_inertia = inverse_inertia(own, c.inv_mass(), c.radius);
+        let turning = match (w, inv_inertia) {
+            (0.0, _) => 0.0,
+            (_, 0.0) => f64::INFINITY,
+            (w, k) => 0.5 * w * w / k,
+        };
+        0.5 * c.velocity.length_squared() / c.inv_mass() + turning
+    };
+    let circles: Vec<CircleState> = with_entities.iter().map(|&(_, c)| c).collect();
     let movable = circles.iter().filter(|c| c.inv_mass() > 0.0);
-    // Each a uniform disc, as a resumed checkpoint's circles are: ½ m v² + ¼ m r² ω².
-    let kinetic: f64 = movable
-        .clone()
-        .map(|c| {
-            let surface = turning(c) * c.radius;
-            (0.5 * c.velocity.length_squared() + 0.25 * surface * surface) / c.inv_mass()
-        })
+    let kinetic: f64 = with_entities
+        .iter()
+        .filter(|(_, c)| c.inv_mass() > 0.0)
+        .map(energy)
         .sum();
     let lightest = movable.map(|c| c.inv_mass()).fold(0.0, f64::max);
     let fall = 2.0 * gravity * arena.size().max_element();

@@ -68,9 +68,15 @@ pub(super) fn gather(world: &World, entities: &[Entity]) -> Vec<OwnParts> {
 }
 
 /// Whether `own` fits `circles` circles: each named once, in increasing order, within range;
-/// restitutions in `[0, 1]`, friction from 0 to [`MAX_FRICTION`] (as the components say),
-/// moments of inertia numbers; a sensor's overlaps other circles, in increasing order.
+/// restitutions in `[0, 1]`, friction from 0 to [`MAX_FRICTION`] (the ranges the components
+/// document), moments of inertia numbers; a sensor's overlaps other circles that are not
+/// sensors, in increasing order.
 pub(super) fn check(own: &[OwnParts], circles: usize) -> Result<(), String> {
+    let sensors: Vec<u32> = own
+        .iter()
+        .filter(|p| p.sensor.is_some())
+        .map(|p| p.circle)
+        .collect();
     let mut last = None;
     for parts in own {
         let i = parts.circle;
@@ -92,7 +98,8 @@ pub(super) fn check(own: &[OwnParts], circles: usize) -> Result<(), String> {
         }
         if let Some(overlaps) = &parts.sensor {
             let increasing = overlaps.windows(2).all(|w| w[0] < w[1]);
-            if !increasing || overlaps.iter().any(|&k| k == i || k as usize >= circles) {
+            let wrong = |k: &u32| *k as usize >= circles || sensors.binary_search(k).is_ok();
+            if !increasing || overlaps.iter().any(wrong) {
                 return Err(format!(
                     "sensor circle {i} overlaps circles out of order or range"
                 ));

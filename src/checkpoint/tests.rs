@@ -1,6 +1,6 @@
 //! What the checkpoint reader refuses of a checkpoint we wrote, edited: an arena that no longer
 //! holds its circles, an impossible radius, a sleeper that moves or turns, a rotation out of
-//! range, a clock that is not its steps.
+//! range, a clock that is not its steps, parts of their own out of range or order.
 
 use super::*;
 use bevy::math::DVec2;
@@ -101,11 +101,17 @@ fn parts_of_their_own_out_of_range_or_order_are_refused() {
         .entity_mut(circles[1])
         .insert((Restitution(0.5), Friction(0.2)));
     world.entity_mut(circles[4]).insert((Inertia(0.01), Sensor));
+    world.entity_mut(circles[6]).insert(Sensor);
     app.update();
     let progress = Progress::start(app.world_mut());
     let good = Checkpoint::take(app.world_mut(), "t", &progress);
-    assert_eq!(good.own.len(), 2, "{:?}", good.own);
+    assert_eq!(good.own.len(), 3, "{:?}", good.own);
     assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    // Which entry is which, in the checkpoint's order of circles.
+    let find = |has: fn(&own::OwnParts) -> bool| good.own.iter().position(has).unwrap();
+    let rubbing = find(|p| p.restitution.is_some());
+    let wheel = find(|p| p.inertia.is_some());
+    let other = find(|p| p.sensor.is_some() && p.inertia.is_none());
     let refused = |edit: &dyn Fn(&mut Checkpoint), says: &str| {
         let mut bad = good.clone();
         edit(&mut bad);
@@ -115,20 +121,30 @@ fn parts_of_their_own_out_of_range_or_order_are_refused() {
         assert!(error.contains(says), "{says}: {error}");
     };
     refused(
-        &|c| c.own[0].restitution = Some(1.5),
+        &|c| c.own[rubbing].restitution = Some(1.5),
         "own restitution is 1.5",
     );
-    refused(&|c| c.own[0].friction = Some(-0.1), "own friction");
+    refused(&|c| c.own[rubbing].friction = Some(-0.1), "own friction");
     refused(
-        &|c| c.own[1].inertia = Some(f64::NAN),
+        &|c| c.own[wheel].inertia = Some(f64::NAN),
         "own moment of inertia",
     );
-    refused(&|c| c.own[1].circle = 8, "out of order or range");
-    assert!(good.own[1].sensor.is_some(), "{:?}", good.own);
+    refused(&|c| c.own[2].circle = 8, "out of order or range");
     refused(&|c| c.own.swap(0, 1), "out of order or range");
-    let sensor = good.own[1].circle;
+    // A sensor overlapping itself, circles out of order, or another sensor.
+    let sensor = good.own[wheel].circle;
     let says = format!("sensor circle {sensor} overlaps");
-    refused(&|c| c.own[1].sensor = Some(vec![sensor]), &says);
-    let (a, b) = ((sensor + 1) % 8, (sensor + 2) % 8);
-    refused(&|c| c.own[1].sensor = Some(vec![a.max(b), a.min(b)]), &says);
+    refused(&|c| c.own[wheel].sensor = Some(vec![sensor]), &says);
+    let plain: Vec<u32> = (0..8)
+        .filter(|k| good.own.iter().all(|p| p.circle != *k))
+        .collect();
+    refused(
+        &|c| c.own[wheel].sensor = Some(vec![plain[1], plain[0]]),
+        &says,
+    );
+    let second = good.own[other].circle;
+    refused(&|c| c.own[wheel].sensor = Some(vec![second]), &says);
+    let mut fine = good.clone();
+    fine.own[wheel].sensor = Some(vec![plain[0], plain[1]]);
+    assert!(Checkpoint::from_bytes(&fine.to_bytes(), "c").is_ok());
 }

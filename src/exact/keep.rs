@@ -59,8 +59,8 @@ impl EngineState {
     /// steps; where the next step would build a fresh engine (the setup or the segment walls
     /// changed, circles came, went or changed their radius or mass, or more than one in
     /// `MOVED_FOR_REBUILD` was moved); and while circles meet nothing (sensors): its cells
-    /// are sized without them, and a checkpoint carries no layers. The resumed run then builds
-    /// its engine afresh from the state, as the next step would.
+    /// are sized without them. The resumed run then builds its engine afresh from the state,
+    /// as the next step would (and where circles have layers, which a restored engine lacks).
     pub fn snapshot(
         &self,
         setup: (Arena, Effects, Solver),

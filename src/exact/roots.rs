@@ -240,8 +240,10 @@ fn split(a: f64, b: f64) -> f64 {
     } else if b <= 0.0 {
         -split(-b, -a)
     } else {
-        // Both finite or `b` infinite: the sum of two patterns below 0x7FF1… fits.
-        f64::from_bits((a.max(0.0).to_bits() + b.to_bits()) / 2)
+        // From +0 (never −0, whose pattern is the sign bit); `b` finite or infinite: the sum
+        // of two patterns below 0x7FF1… fits.
+        let low = if a > 0.0 { a.to_bits() } else { 0 };
+        f64::from_bits((low + b.to_bits()) / 2)
     }
 }
 
@@ -318,6 +320,9 @@ mod tests {
         assert_eq!(split(-4.0, -1.0), -2.0);
         assert_eq!(split(1.0, 1.0f64.next_up()), 1.0);
         assert_eq!(split(1.0, 4.0), 2.0);
+        // A zero of either sign splits as +0.
+        assert!((-1.0..0.0).contains(&split(-1.0, 0.0)));
+        assert!((0.0..1.0).contains(&split(-0.0, 1.0)) && split(-0.0, 1.0) > 0.0);
     }
 
     #[test]

@@ -79,14 +79,17 @@ fn bin_in_cell_order(
     });
 }
 
-/// Rows of cells per band of [`fold_pairs_by_band`]: a fixed number, so that which pairs are
-/// folded together, and in what order, does not depend on the number of threads.
+/// Rows of cells per band of [`fold_pairs_by_band`], at least: a number fixed by the grid, so
+/// that which pairs are folded together, and in what order, does not depend on the threads.
 const BAND_ROWS: usize = 16;
+/// Bands of [`fold_pairs_by_band`], at most (a grid one cell wide may have 4 N rows).
+const MAX_BANDS: usize = 1024;
 
 /// Folds every overlapping pair of `circles` (centre, reach), as input indices `(i, j)` with
-/// `i < j` and the two circles (read in cell order, near each other in memory), into one value per band of [`BAND_ROWS`] rows of the single-level grid (pairs in
-/// scan order within a band), the bands on all cores for large inputs, without listing the
-/// pairs; returns the bands' values in row order, the same whatever the number of threads.
+/// `i < j` and the two circles (read in cell order, near each other in memory), into one value
+/// per band of rows of the single-level grid (pairs in scan order within a band),
+/// the bands on all cores for large inputs, without listing the pairs; returns the bands'
+/// values in row order, the same whatever the number of threads.
 /// `None` where the grid is too coarse for each pair to come once (a periodic arena a few
 /// cells wide): the caller lists the pairs instead.
 pub fn fold_pairs_by_band<T: Send + 'static>(
@@ -113,8 +116,8 @@ pub fn fold_pairs_by_band<T: Send + 'static>(
         value
     };
     let rows = cells.grid.rows;
-    let bands =
-        (0..rows.div_ceil(BAND_ROWS)).map(|b| b * BAND_ROWS..((b + 1) * BAND_ROWS).min(rows));
+    let per_band = BAND_ROWS.max(rows.div_ceil(MAX_BANDS));
+    let bands = (0..rows.div_ceil(per_band)).map(|b| b * per_band..((b + 1) * per_band).min(rows));
     if circles.len() < PARALLEL_FROM {
         return Some(bands.map(band).collect());
     }
