@@ -47,11 +47,12 @@ impl EventEngine {
     ) -> BestPair {
         let me = self.motion[i];
         let mut best = NO_PAIR;
+        let nearest = |d: DVec2| self.nearest_image(d);
         let mut look = |j: usize| {
             if FALL {
-                self.look_falling(i, j, &mut best);
+                self.look_falling(i, j, nearest, &mut best);
             } else {
-                self.look_at::<IMAGES>(&me, j, &mut best);
+                self.look_at::<IMAGES>(&me, j, nearest, &mut best);
             }
         };
         // With layers, a pair that does not meet has no event (a branch the same way for every
@@ -75,7 +76,14 @@ impl EventEngine {
 
     /// [`EventEngine::look_at`] under gravity: the pair's positions and velocities at the later
     /// of their reference times on their own courses, and the quartic when only one falls.
-    fn look_falling(&self, i: usize, j: usize, best: &mut BestPair) {
+    #[inline(always)]
+    pub(super) fn look_falling(
+        &self,
+        i: usize,
+        j: usize,
+        image: impl Fn(DVec2) -> DVec2,
+        best: &mut BestPair,
+    ) {
         let (me, other) = (&self.motion[i], &self.motion[j]);
         let now = self.now;
         let since = me.t_at.max(other.t_at);
@@ -84,9 +92,7 @@ impl EventEngine {
         let da = self.acceleration(j) - self.acceleration(i);
         if self.grid.periodic {
             let tau = now - since;
-            let d = dp + dv * tau + 0.5 * da * (tau * tau);
-            dp.x -= whole_periods(d.x, self.period.x);
-            dp.y -= whole_periods(d.y, self.period.y);
+            dp -= self.period * image(dp + dv * tau + 0.5 * da * (tau * tau));
         }
         let sum = me.radius + other.radius;
         let impact = if da == DVec2::ZERO {
@@ -109,7 +115,8 @@ impl EventEngine {
     }
 
     /// Keeps in `best` the sooner of it and the collision of the circle moving as `me` with
-    /// circle `j`, if they collide: through the image they are nearest in now, or, with
+    /// circle `j`, if they collide: through the image `image` picks from where they are now
+    /// relative to each other (the nearest, when predicting), or, with
     /// `IMAGES` (`walls::images_wrap`), through the soonest of it and the images up to
     /// two periods either side (each circle crosses a cell edge before it moves a cell, at
     /// least a quarter of the box, and is predicted again then).
@@ -118,7 +125,13 @@ impl EventEngine {
     /// now, so it depends on the two motions alone: when the pair is looked at (after which
     /// cell crossing) cannot change it, and the cell grid does not change the trajectories.
     #[inline(always)]
-    fn look_at<const IMAGES: bool>(&self, me: &Motion, j: usize, best: &mut BestPair) {
+    pub(super) fn look_at<const IMAGES: bool>(
+        &self,
+        me: &Motion,
+        j: usize,
+        image: impl Fn(DVec2) -> DVec2,
+        best: &mut BestPair,
+    ) {
         let now = self.now;
         let other = &self.motion[j];
         // From the later reference time, where one of the two is at its reference point
@@ -129,9 +142,7 @@ impl EventEngine {
         if self.grid.periodic {
             // Through the image the pair is nearest in now: they may have flown far since
             // `since`.
-            let d = dp + dv * (now - since);
-            dp.x -= whole_periods(d.x, self.period.x);
-            dp.y -= whole_periods(d.y, self.period.y);
+            dp -= self.period * image(dp + dv * (now - since));
         }
         let sum = me.radius + other.radius;
         let impact = if IMAGES && self.growth == 0.0 {
@@ -358,6 +369,22 @@ impl EventEngine {
             self.predict(i);
         }
         true
+    }
+}
+
+impl EventEngine {
+    /// How many whole periods along each axis the displacement `d` is beyond its minimum image
+    /// (`d` minus that many periods is within half a period).
+    #[inline]
+    pub(super) fn nearest_image(&self, d: DVec2) -> DVec2 {
+        let whole = |d: f64, period: f64| {
+            if d.abs() > 0.5 * period {
+                (d / period).round()
+            } else {
+                0.0
+            }
+        };
+        DVec2::new(whole(d.x, self.period.x), whole(d.y, self.period.y))
     }
 }
 
