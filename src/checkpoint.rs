@@ -299,6 +299,13 @@ impl Checkpoint {
         if numbers.iter().any(|x| !x.is_finite()) {
             return Err("a counter or total is not finite".to_owned());
         }
+        // Energies of motion and of turning are never below zero (that of height may be, in an
+        // open arena), and their sum is the report's first energy (the fuzz target's find: two
+        // of -1.2e308 summed to -∞, which every report of the run then carried).
+        let b = &p.before;
+        if b.kinetic_energy < 0.0 || b.rotational_energy < 0.0 || !b.energy().is_finite() {
+            return Err("its first energies are below zero or sum past the range".to_owned());
+        }
         // The clock is the sum of `steps` steps of `dt`, to the rounding of such a sum: a clock
         // run backwards or far ahead would change how finely event times resolve.
         let clock = self.steps.steps as f64 * self.dt;

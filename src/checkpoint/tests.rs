@@ -1,6 +1,7 @@
 //! What the checkpoint reader refuses of a checkpoint we wrote, edited: an arena that no longer
 //! holds its circles, an impossible radius, a sleeper that moves or turns, a rotation out of
-//! range, a clock that is not its steps, parts of their own out of range or order.
+//! range, a clock that is not its steps, parts of their own out of range or order, first
+//! energies below zero or past the range.
 
 use super::*;
 use bevy::math::DVec2;
@@ -147,4 +148,29 @@ fn parts_of_their_own_out_of_range_or_order_are_refused() {
     let mut fine = good.clone();
     fine.own[wheel].sensor = Some(vec![plain[0], plain[1]]);
     assert!(Checkpoint::from_bytes(&fine.to_bytes(), "c").is_ok());
+}
+
+#[test]
+fn first_energies_below_zero_or_past_the_range_are_refused() {
+    let mut config = CirclesConfig::default();
+    config.spawn.count = 8;
+    let mut app = headless_app(config);
+    app.update();
+    let progress = Progress::start(app.world_mut());
+    let good = Checkpoint::take(app.world_mut(), "t", &progress);
+    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    // Each finite, as the fuzz target found them: their sum is -∞, and so was every report's
+    // first energy.
+    let mut bad = good.clone();
+    bad.progress.before.kinetic_energy = -1.29e308;
+    bad.progress.before.rotational_energy = -1.18e308;
+    let mut huge = good.clone();
+    huge.progress.before.kinetic_energy = 1.5e308;
+    huge.progress.before.rotational_energy = 1.5e308;
+    for bad in [bad, huge] {
+        let error = Checkpoint::from_bytes(&bad.to_bytes(), "c")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("first energies"), "{error}");
+    }
 }

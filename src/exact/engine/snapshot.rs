@@ -96,6 +96,13 @@ impl EventEngine {
         if !s.now.is_finite() {
             return Err(format!("engine clock {} is not finite", s.now));
         }
+        // What the engine has added up, from which each step's counts are taken (the fuzz
+        // target's find: a wall impulse of NaN made every count after it NaN).
+        let st = &s.stats;
+        let sums = [st.wall_impulse, st.virial, st.immovable_work];
+        if !(sums.iter().all(|x| x.is_finite()) && st.immovable_impulse.is_finite()) {
+            return Err("engine state's sums are not finite".to_owned());
+        }
         let size = arena.size();
         let width = cell_width(arena, circles, &[]);
         let Layout {

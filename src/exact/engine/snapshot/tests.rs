@@ -112,8 +112,10 @@ fn a_damaged_snapshot_is_refused_not_followed() {
     let pending = (0..64)
         .find(|&i| good.event[i].kind == Kind::Pair)
         .expect("a pending collision");
-    let damages: [fn(&mut EngineSnapshot, usize); 14] = [
+    let damages: [fn(&mut EngineSnapshot, usize); 16] = [
         |s, _| s.now = f64::NAN,
+        |s, _| s.stats.wall_impulse = f64::NAN,
+        |s, _| s.stats.virial = f64::INFINITY,
         |s, _| s.time[3] = f64::NAN,
         |s, _| s.cell_x[5] = 1_000,
         |s, _| s.counter.pop().map(drop).unwrap_or(()),
