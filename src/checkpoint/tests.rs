@@ -6,6 +6,14 @@
 use super::*;
 use bevy::math::DVec2;
 
+/// The checkpoint of `app` as it is, which our reader takes back.
+fn taken(app: &mut App) -> Checkpoint {
+    let progress = Progress::start(app.world_mut());
+    let good = Checkpoint::take(app.world_mut(), "t", &progress);
+    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    good
+}
+
 #[test]
 fn a_checkpoint_whose_arena_no_longer_holds_its_circles_is_refused() {
     let mut config = CirclesConfig::default();
@@ -13,9 +21,7 @@ fn a_checkpoint_whose_arena_no_longer_holds_its_circles_is_refused() {
     config.solver = Solver::Exact;
     let mut app = headless_app(config);
     app.update();
-    let progress = Progress::start(app.world_mut());
-    let good = Checkpoint::take(app.world_mut(), "t", &progress);
-    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    let good = taken(&mut app);
     // A bound moved within the range of values, past the circles on that side.
     let mut moved = good.clone();
     let leftmost = good
@@ -67,9 +73,7 @@ fn a_clock_that_is_not_its_steps_is_refused() {
     for _ in 0..40 {
         app.update();
     }
-    let progress = Progress::start(app.world_mut());
-    let good = Checkpoint::take(app.world_mut(), "t", &progress);
-    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    let good = taken(&mut app);
     // Run backwards (the fuzzer's find: a negative clock hid how coarsely a fast circle's
     // events resolve) or far ahead.
     for clock in [
@@ -156,9 +160,7 @@ fn first_energies_below_zero_or_past_the_range_are_refused() {
     config.spawn.count = 8;
     let mut app = headless_app(config);
     app.update();
-    let progress = Progress::start(app.world_mut());
-    let good = Checkpoint::take(app.world_mut(), "t", &progress);
-    assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
+    let good = taken(&mut app);
     // Each finite, as the fuzz target found them: their sum is -∞, and so was every report's
     // first energy.
     let mut bad = good.clone();
