@@ -31,12 +31,15 @@ pub fn inertia(own: Option<f64>, mass: f64, radius: f64) -> f64 {
 }
 
 /// [`inertia`]'s inverse from the inverse mass: 0 for a circle that does not turn from a
-/// push: immovable (`w = 0`), or of an own inertia that is infinite or not above 0.
+/// push: immovable (`w = 0`), or of an own inertia that is infinite or not above 0. An own
+/// inertia so small that its inverse passes the range of values (below about 5.6e-309) turns as
+/// the smallest whose inverse is finite: an infinite inverse would make every hit's turning
+/// `0 × ∞`, not a number.
 #[inline]
 pub fn inverse_inertia(own: Option<f64>, inv_mass: f64, radius: f64) -> f64 {
     match own {
         _ if inv_mass == 0.0 => 0.0,
-        Some(i) if i > 0.0 => 1.0 / i,
+        Some(i) if i > 0.0 => (1.0 / i).min(f64::MAX),
         Some(_) => 0.0,
         None => disc_inverse_inertia(inv_mass, radius),
     }

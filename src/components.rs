@@ -127,7 +127,9 @@ impl Rotation {
 /// A circle's own moment of inertia about its centre (kg·m²): a hollow ring (`m r²`), a ball
 /// with a heavy core, a wheel. Without it a circle turns as a uniform disc of its mass and
 /// radius, `m r² / 2`. Contacts with friction (`soft`) and rough hits (`swept`, `exact`) turn
-/// it through this; `f64::INFINITY` (or any value not above 0) keeps it from turning at all.
+/// it through this; `f64::INFINITY` (or any value not above 0) keeps it from turning at all,
+/// and a value so small that its inverse passes the range of numbers (below about 5.6e-309)
+/// turns as the smallest whose inverse does not.
 ///
 /// ```
 /// use bevy::prelude::*;

@@ -61,7 +61,6 @@ pub fn apply_turning(
     if c.b != NONE {
         let b = c.b as usize;
         if wa == 0.0 || wb == 0.0 {
-            // The immovable side's surface velocity at the contact, times what it gave.
             // The immovable side's surface velocity at the contact times what it gave, and its
             // turning times the torque it gave.
             work = if wa == 0.0 {

@@ -313,6 +313,10 @@ fn a_spinning_ball_dropped_on_a_rough_floor_bounces_off_sideways_rolling() {
             (spin + 5.0).abs() < 1e-12 && (v.x - 2.5).abs() < 1e-12,
             "{v} {spin}"
         );
+        // A moment of inertia too small for its inverse to be a number (1e-310) turns as the
+        // smallest whose inverse is: the spin alone takes up the slip, nothing moves sideways.
+        let (v, spin) = dropped_spinning_with(0.0, on_segment, Some(1e-310));
+        assert!(v.x.abs() < 1e-12 && spin.abs() < 1e-12, "{v} {spin}");
     }
 }
 
