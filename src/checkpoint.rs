@@ -83,12 +83,18 @@ impl Checkpoint {
             *world.resource::<Effects>(),
             *world.resource::<Solver>(),
         );
-        let state = world.resource::<EngineState>();
-        let engine = state.snapshot(setup, world.resource::<Segments>(), &with_entities);
-        let budget_exhausted = state.budget_exhausted;
-        let (entities, circles): (Vec<Entity>, Vec<CircleState>) =
-            with_entities.into_iter().unzip();
+        let entities: Vec<Entity> = with_entities.iter().map(|(e, _)| *e).collect();
         let own = own::gather(world, &entities);
+        let state = world.resource::<EngineState>();
+        // A restored engine has no layers: where circles have them it is not kept, and the
+        // resumed run builds one (as the next step would on seeing them changed).
+        let engine = if own.iter().all(|p| p.layers.is_none()) {
+            state.snapshot(setup, world.resource::<Segments>(), &with_entities)
+        } else {
+            None
+        };
+        let budget_exhausted = state.budget_exhausted;
+        let circles: Vec<CircleState> = with_entities.into_iter().map(|(_, c)| c).collect();
         let contacts = match world.resource::<Solver>() {
             Solver::Soft(_) => world.resource::<SoftState>().snapshot(&entities),
             _ => None,
@@ -134,9 +140,7 @@ impl Checkpoint {
                 last_sample: None,
                 ..*progress
             },
-            // A restored engine has no layers: where circles have them it is not kept, and the
-            // resumed run builds one (as the next step would on seeing them changed).
-            engine: engine.filter(|_| own.iter().all(|p| p.layers.is_none())),
+            engine,
             contacts,
             own,
         }
