@@ -36,7 +36,8 @@ enum Command {
         /// Folder for accuracy.csv, accuracy.svg, accuracy.png and piles.csv.
         #[arg(long, value_name = "DIR", default_value = "out")]
         out: PathBuf,
-        /// Folder the study's scenes (gas1k, gas, billiards, fast; galton, pile) are read from.
+        /// Folder the study's scenes are read from: gas1k, gas, billiards, fast, rough_gas; galton
+        /// and pile (pyramid with `--quick`).
         #[arg(long, value_name = "DIR", default_value = "assets/scenes")]
         scenes: PathBuf,
         /// One step size and shorter runs: a smoke test of the study, not a measurement.

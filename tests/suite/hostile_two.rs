@@ -47,6 +47,21 @@ fn a_long_thin_arena_runs_in_bounded_memory() {
             );
         }
     }
+    // The study on thin arenas: every scene it reads is one, walled.
+    let scenes = dir.join("scenes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    for name in ["gas1k", "gas", "billiards", "fast", "rough_gas", "pyramid"] {
+        std::fs::write(
+            scenes.join(format!("{name}.ron")),
+            "(arena: (size: (1e18, 9.0), boundary: walls), \
+              spawn: (count: 32, radius: (0.1, 0.2)))",
+        )
+        .unwrap();
+    }
+    let (scenes, out) = (scenes.to_str().unwrap(), dir.join("out"));
+    let args = ["accuracy", "--quick", "--scenes", scenes, "--out"];
+    let out = under_one_gib(&[&args[..], &[out.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "accuracy: {}", stderr(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -243,8 +258,57 @@ fn an_output_never_replaces_the_runs_own_input() {
     let again = ["run", "--resume", checkpoint, "--steps", "2"];
     let out = under_one_gib(&[&again[..], &["--checkpoint", checkpoint]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
-    let out = under_one_gib(&[&again[..], &["--report", checkpoint]].concat());
-    assert_refused(&out, &["--report names the input of --resume"]);
+    for flag in ["--report", "--dump"] {
+        let out = under_one_gib(&[&again[..], &[flag, checkpoint]].concat());
+        assert_refused(&out, &[&format!("{flag} names the input of --resume")]);
+    }
+    // A particle file, as a scene.
+    let particles = dir.join("p.txt");
+    let dump = ["run", "--scene", scene, "--steps", "1", "--dump"];
+    let out = under_one_gib(&[&dump[..], &[particles.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let written = std::fs::read(&particles).unwrap();
+    let particles = particles.to_str().unwrap();
+    for flag in ["--report", "--dump", "--checkpoint"] {
+        let args = [
+            "run",
+            "--particles",
+            particles,
+            "--steps",
+            "1",
+            flag,
+            particles,
+        ];
+        assert_refused(
+            &under_one_gib(&args),
+            &[&format!("{flag} names the input of --particles")],
+        );
+    }
+    assert_eq!(std::fs::read(particles).unwrap(), written);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_drop_rule_out_of_range_is_refused_by_the_run_naming_the_file_and_field() {
+    let dir = temp_dir("drops");
+    // A subnormal radius, and a mass from the drops' own radius below the least mass.
+    for (rule, field) in [
+        (
+            "(drop: (count: 1, radius: 5e-324, position: (0.0, 0.0)))",
+            "field `drop.radius`",
+        ),
+        (
+            "(arena: (size: (1e-3, 1e-3)), spawn: (count: 0, radius: (1e-5, 1e-5)), \
+             mass: Area(density: 1e-20), drop: (count: 1, radius: 1e-6, position: (0.0, 0.0)))",
+            "field `drop.radius`",
+        ),
+    ] {
+        let scene = dir.join("drops.ron");
+        std::fs::write(&scene, rule).unwrap();
+        let scene = scene.to_str().unwrap();
+        let out = under_one_gib(&["run", "--scene", scene, "--steps", "2"]);
+        assert_refused(&out, &[scene, field]);
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -4,8 +4,9 @@
 //! and a second signal ends it at once without touching what was there; a signal while the
 //! circles are being placed ends it at once, writing nothing. And, in the library, a
 //! resumed `exact` app goes on with the engine it restored instead of rebuilding one (with
-//! circles of their own restitution too); a kinematic circle and the hit messages resume bit
-//! for bit under every solver; and what code gave circles of their own is kept.
+//! circles of their own restitution too); a kinematic circle, the hit messages and circles
+//! of their own restitution resume bit for bit under every solver; and what code gave circles
+//! of their own is kept.
 #![cfg(unix)]
 
 use std::path::{Path, PathBuf};
@@ -138,17 +139,22 @@ fn a_checkpoint_that_is_damaged_or_not_one_is_refused_by_name() {
     let mut flipped = good.clone();
     let last = flipped.len() - 9;
     flipped[last] ^= 0x40;
-    let cases: [(&[u8], &str); 4] = [
+    // Everything after the format's name at its largest: every length and count it reads
+    // claims more than memory holds.
+    let header = b"\x1bmoving_circles checkpoint ".len() + 2;
+    let mut largest = good.clone();
+    largest[header..].fill(0xff);
+    let cases: [(&[u8], &str); 5] = [
         (b"", "not a moving_circles checkpoint"),
         (b"hello, world", "not a moving_circles checkpoint"),
         (&truncated, "damaged checkpoint"),
+        (&largest, "damaged checkpoint"),
         (&flipped, ""),
     ];
     for (bytes, expected) in cases {
         std::fs::write(&checkpoint, bytes).unwrap();
-        let out = command(&["run", "--resume", c, "--steps", "5"])
-            .output()
-            .unwrap();
+        // Refused before allocating what it claims: within the memory bound.
+        let out = crate::common::binary::under_one_gib(&["run", "--resume", c, "--steps", "5"]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!stderr.contains("panicked"), "{stderr}");
         if out.status.success() {
@@ -279,15 +285,22 @@ fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
 
 #[test]
 fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
+    // Four million circles at random, or a hundred thousand compressed to 0.8: seconds to
+    // place in a release build, minutes in a test build.
+    let random = "(arena: (size: (560.0, 560.0), boundary: periodic), \
+         effects: (collisions: true), spawn: (count: 4000000, radius: (0.05, 0.1), seed: 1))";
+    let pack = "(arena: (size: (63.0, 63.0), boundary: walls), effects: (collisions: true), \
+         spawn: (placement: pack, count: 100000, radius: (0.1, 0.1), seed: 1))";
+    signalled_while_placing(random, "placing at random 4000000");
+    signalled_while_placing(pack, "compressing 100000");
+}
+
+/// Runs `scene`, signals it as soon as it says it is `placing` (its first line), and asserts
+/// it ends within a second writing nothing.
+fn signalled_while_placing(scene_text: &str, placing: &str) {
     let dir = temp_dir("placing");
     let (scene, report) = (dir.join("big.ron"), dir.join("r.json"));
-    // Four million circles: seconds to place, minutes in a test build.
-    std::fs::write(
-        &scene,
-        "(arena: (size: (560.0, 560.0), boundary: periodic), effects: (collisions: true), \
-         spawn: (count: 4000000, radius: (0.05, 0.1), seed: 1))",
-    )
-    .unwrap();
+    std::fs::write(&scene, scene_text).unwrap();
     std::fs::write(&report, "old").unwrap();
     let mut child = command(&[
         "run",
@@ -306,7 +319,7 @@ fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
     let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
     let mut said = String::new();
     std::io::BufRead::read_line(&mut stderr, &mut said).unwrap();
-    assert!(said.contains("placing at random"), "{said}");
+    assert!(said.contains(placing), "{said}");
     signal(&child, "TERM");
     let sent = Instant::now();
     let status = child.wait().unwrap();
@@ -572,6 +585,23 @@ fn a_kinematic_circle_and_the_hit_messages_resume_bit_for_bit_under_every_solver
     resumes_bit_for_bit(scene, |i, circle| {
         if i == 0 {
             circle.insert(Mass::IMMOVABLE);
+        }
+    });
+}
+
+#[test]
+fn circles_of_their_own_restitution_resume_bit_for_bit_under_every_solver() {
+    use moving_circles::prelude::*;
+    // A box under gravity, hit messages on: every fourth circle given a restitution of its
+    // own by code as it is made. (Circles given parts of several kinds resume equal to
+    // rounding: see `own::apply`.)
+    let scene = "(arena: (size: (8.0, 6.0), boundary: walls),
+        effects: (collisions: true, hit_messages: true, restitution: 0.9,
+                  gravity: (0.0, -3.0)),
+        spawn: (count: 40, radius: (0.15, 0.3), speed: (2.0, 6.0), seed: 8))";
+    resumes_bit_for_bit(scene, |i, circle| {
+        if i % 4 == 0 {
+            circle.insert(Restitution(0.3));
         }
     });
 }
