@@ -112,10 +112,12 @@ pub(super) fn check(own: &[OwnParts], circles: usize) -> Result<(), String> {
 /// Puts `own` back on the circles `entities` (the checkpoint's circles, in order, as resumed).
 ///
 /// Bevy groups entities by the components they have, and the solvers take the circles in
-/// query order, which follows those groups and the order they were made in: a run whose
-/// circles gained parts of their own in the course of a game resumes with each circle as it
-/// was, but its circles may come in another order, so it goes on equal to rounding rather than
-/// bit for bit (what no code touched, every scene and `moving_circles run`, is bit for bit).
+/// query order, which follows those groups and the order they were made in. Circles given one
+/// kind of part come back in their order (the checkpoint lists them in query order, and the
+/// parts go on in that order), so the run resumes bit for bit; where circles have parts of
+/// several kinds the groups may come back in another order, and the run goes on equal to
+/// rounding rather than bit for bit (what no code touched, every scene and `moving_circles
+/// run`, is bit for bit).
 pub(super) fn apply(own: &[OwnParts], world: &mut World, entities: &[Entity]) {
     for parts in own {
         let mut e = world.entity_mut(entities[parts.circle as usize]);
