@@ -3,16 +3,30 @@
 //! must get.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
-/// `moving_circles` with `args`, from the crate's folder, with no display.
-pub fn moving_circles(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+/// `moving_circles` with `args`, from the crate's folder, with no display and no input, to be
+/// spawned or run.
+pub fn command(args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_moving_circles"));
+    command
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env("DISPLAY", "")
         .args(args)
-        .output()
-        .expect("runs")
+        .stdin(Stdio::null());
+    command
+}
+
+/// [`command`] run to its end.
+pub fn moving_circles(args: &[&str]) -> Output {
+    command(args).output().expect("runs")
+}
+
+/// [`moving_circles`], asserting the run succeeded.
+pub fn successful(args: &[&str]) -> Output {
+    let out = moving_circles(args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    out
 }
 
 /// `moving_circles` under a 1 GiB address-space limit: what "no more than 1 GB before refusing"

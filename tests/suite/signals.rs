@@ -1,0 +1,235 @@
+//! Signals through the real binary: SIGINT or SIGTERM ends a run after a whole step with its
+//! report, final state and checkpoint written; a long event-driven step is cut short within a
+//! second of the signal; a signal while the circles are placed or compressed ends the run at
+//! once, writing nothing; and a second signal ends it at once without touching what was there.
+#![cfg(unix)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::common::binary::{command, successful};
+
+fn temp_dir(name: &str) -> PathBuf {
+    crate::common::binary::scratch_dir("signals", name)
+}
+
+fn text(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// Starts a long run of the 10 000-circle gas writing everything, and waits until it has
+/// written its first checkpoint (so it is stepping).
+fn start_long_run(dir: &Path) -> Child {
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let checkpoint = dir.join("c");
+    let child = command(&[
+        "run",
+        "--scene",
+        "assets/scenes/gas.ron",
+        "--solver",
+        "exact",
+        "--steps",
+        "10000000",
+        "--report",
+        &p("r.json"),
+        "--dump",
+        &p("d.txt"),
+        "--checkpoint",
+        &p("c"),
+        "--every",
+        "3",
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .unwrap();
+    let start = Instant::now();
+    while !checkpoint.exists() {
+        assert!(start.elapsed() < Duration::from_secs(120), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child
+}
+
+fn signal(child: &Child, name: &str) {
+    let status = Command::new("kill")
+        .args([&format!("-{name}"), &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+#[test]
+fn a_signal_ends_the_run_after_a_step_with_everything_written() {
+    for (name, code) in [("INT", 130), ("TERM", 143)] {
+        let dir = temp_dir(&format!("signal-{name}"));
+        let mut child = start_long_run(&dir);
+        signal(&child, name);
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "SIG{name}");
+        let report: serde_json::Value = serde_json::from_str(&text(&dir.join("r.json"))).unwrap();
+        assert_eq!(report["interrupted"], true);
+        let steps = report["steps"].as_u64().unwrap();
+        assert!(steps >= 3, "{steps} steps");
+        // The dump is the state after the last whole step, and the checkpoint goes on from it.
+        let dump = text(&dir.join("d.txt"));
+        assert_eq!(dump.lines().count(), 10_029);
+        let c = dir.join("c");
+        let again = dir.join("again.json");
+        successful(&[
+            "run",
+            "--resume",
+            c.to_str().unwrap(),
+            "--steps",
+            "1",
+            "--report",
+            again.to_str().unwrap(),
+        ]);
+        let again: serde_json::Value = serde_json::from_str(&text(&again)).unwrap();
+        assert_eq!(again["steps"].as_u64(), Some(steps + 1));
+        assert_eq!(again["interrupted"], false);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
+    let dir = temp_dir("long-step");
+    let report = dir.join("r.json");
+    // One step of 60 s of the 10 000-circle gas: seconds of events.
+    let mut child = command(&[
+        "run",
+        "--scene",
+        "assets/scenes/gas.ron",
+        "--solver",
+        "exact",
+        "--dt",
+        "60",
+        "--steps",
+        "3",
+        "--report",
+        report.to_str().unwrap(),
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, "TERM");
+    let sent = Instant::now();
+    let status = child.wait().unwrap();
+    let took = sent.elapsed();
+    assert_eq!(status.code(), Some(143));
+    let report: serde_json::Value = serde_json::from_str(&text(&report)).unwrap();
+    assert_eq!(report["interrupted"], true);
+    // The step was ended by drifting to its end, as when the event budget runs out.
+    assert_eq!(report["steps"].as_u64(), Some(1), "{report}");
+    assert_eq!(report["budget_exhausted"].as_u64(), Some(1), "{report}");
+    assert!(
+        took < Duration::from_secs(2),
+        "the run took {took:?} to stop"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
+    // Four million circles at random, or a hundred thousand compressed to 0.8: seconds to
+    // place in a release build, minutes in a test build.
+    let random = "(arena: (size: (560.0, 560.0), boundary: periodic), \
+         effects: (collisions: true), spawn: (count: 4000000, radius: (0.05, 0.1), seed: 1))";
+    let pack = "(arena: (size: (63.0, 63.0), boundary: walls), effects: (collisions: true), \
+         spawn: (placement: pack, count: 100000, radius: (0.1, 0.1), seed: 1))";
+    signalled_while_placing(random, "placing at random 4000000");
+    signalled_while_placing(pack, "compressing 100000");
+}
+
+/// Runs `scene`, signals it as soon as it says it is `placing` (its first line), and asserts
+/// it ends within a second writing nothing.
+fn signalled_while_placing(scene_text: &str, placing: &str) {
+    let dir = temp_dir("placing");
+    let (scene, report) = (dir.join("big.ron"), dir.join("r.json"));
+    std::fs::write(&scene, scene_text).unwrap();
+    std::fs::write(&report, "old").unwrap();
+    let mut child = command(&[
+        "run",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--steps",
+        "10",
+        "--report",
+        report.to_str().unwrap(),
+    ])
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .unwrap();
+    // The run says it is placing them, then places them: the signal comes while it does.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut said = String::new();
+    std::io::BufRead::read_line(&mut stderr, &mut said).unwrap();
+    assert!(said.contains(placing), "{said}");
+    signal(&child, "TERM");
+    let sent = Instant::now();
+    let status = child.wait().unwrap();
+    let took = sent.elapsed();
+    let mut stdout = String::new();
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
+    assert_eq!(status.code(), Some(143), "{stdout}");
+    assert!(
+        stdout.contains("while placing or spawning circles"),
+        "{stdout}"
+    );
+    assert_eq!(
+        text(&report),
+        "old",
+        "nothing was run, so nothing is replaced"
+    );
+    assert!(
+        took < Duration::from_secs(1),
+        "the run took {took:?} to stop"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
+    let dir = temp_dir("twice");
+    let report = dir.join("r.json");
+    std::fs::write(&report, "old").unwrap();
+    // Placing a million circles takes seconds: both signals arrive before the first step.
+    let scene = dir.join("million.ron");
+    std::fs::write(
+        &scene,
+        "(arena: (size: (1000.0, 1000.0)), spawn: (count: 1000000, radius: (0.1, 0.1)))",
+    )
+    .unwrap();
+    let mut child = command(&[
+        "run",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--steps",
+        "100",
+        "--report",
+        report.to_str().unwrap(),
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .unwrap();
+    std::thread::sleep(Duration::from_millis(1000));
+    signal(&child, "INT");
+    std::thread::sleep(Duration::from_millis(100));
+    signal(&child, "INT");
+    let start = Instant::now();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130));
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "did not end at once"
+    );
+    assert_eq!(text(&report), "old");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "a stray file");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
