@@ -39,6 +39,7 @@ mod rough;
 mod scenes;
 mod schedule;
 mod segments;
+mod sensors;
 mod signals;
 mod sleep;
 mod solvers;
