@@ -122,7 +122,36 @@ pub fn falling_pair_time(dp: DVec2, dv: DVec2, da: DVec2, sigma: f64, horizon: f
             }
         }
     }
+    // Apart for good: along some direction the gap never closes to `sigma`, whatever the
+    // horizon. Along the axes (a pair side by side drifting apart, a peg above the top of the
+    // arc) and along the line between them now.
+    let apart = |u: DVec2| stays_beyond(u.dot(dp), u.dot(dv), u.dot(a), sigma);
+    let distance = dp.length();
+    if [DVec2::X, DVec2::NEG_X, DVec2::Y, DVec2::NEG_Y]
+        .into_iter()
+        .any(apart)
+        || (distance > 0.0 && apart(dp / distance))
+    {
+        return None;
+    }
     first_entering_root(&c, horizon)
+}
+
+/// Whether `x + w·τ + α·τ²`, a pair's gap along one direction, stays above `sigma` for every
+/// `τ ≥ 0`, by a margin far above the rounding of its least value: then the distance, which is
+/// at least that, never comes down to `sigma` either. A rule-out only: `false` when unsure
+/// (a gap that shrinks without end, values not numbers).
+fn stays_beyond(x: f64, w: f64, alpha: f64, sigma: f64) -> bool {
+    let (least, scale) = if w >= 0.0 && alpha >= 0.0 {
+        (x, x.abs())
+    } else if alpha > 0.0 {
+        // Least where it turns, at τ = −w / 2α.
+        let dip = w * w / (4.0 * alpha);
+        (x - dip, x.abs() + dip)
+    } else {
+        return false;
+    };
+    least - sigma > 1e-9 * (scale + sigma)
 }
 
 /// When a circle of radius `r` at `p` moving at `v` with acceleration `acc` first touches
