@@ -361,12 +361,24 @@ impl EventEngine {
     /// [`EventEngine::predict_all`], asking `stop` every
     /// [`STOP_POLL_CIRCLES`](super::STOP_POLL_CIRCLES) circles whether to give up; whether it
     /// predicted them all.
+    ///
+    /// When nothing moves (no circle has a velocity or falls, and radii do not grow: a pile
+    /// asleep, which `swept` builds anew every step), no pair can meet, so no circle looks at
+    /// its neighbours: each gets no pair, as looking would have found, and its other events
+    /// are asked as always.
     pub(super) fn predict_all_until(&mut self, stop: impl Fn() -> bool) -> bool {
+        let still = self.growth == 0.0
+            && (0..self.len()).all(|i| !self.falls[i] && self.motion[i].vel == DVec2::ZERO);
         for i in 0..self.len() {
             if i % super::STOP_POLL_CIRCLES == 0 && stop() {
                 return false;
             }
-            self.predict(i);
+            if still {
+                self.best_pair[i] = NO_PAIR;
+                self.schedule(i);
+            } else {
+                self.predict(i);
+            }
         }
         true
     }
