@@ -138,6 +138,36 @@ fn the_column_and_the_pyramid_stand_exactly_and_sleep_under_the_event_driven_sol
     }
 }
 
+/// Runs the scene `text` (named `name`) for 10 s and checks what the event-driven solvers
+/// promise a pile: asleep, no overlap beyond rounding after any step, nothing escaped or
+/// non-finite, the event budget never out. Returns the run's report.
+fn drops_and_sleeps(text: &str, name: &str) -> moving_circles::run::Report {
+    let config = Scene::parse(text, name)
+        .and_then(|s| s.to_config(name))
+        .unwrap();
+    let mut app = create_app(config);
+    let mut deepest = 0.0f64;
+    for _ in 0..10 * 60 {
+        step(&mut app, 1);
+        deepest = deepest.max(overlap(&mut app).max);
+    }
+    let (asleep, _) = settled(&mut app);
+    let report = moving_circles::run::Report::new(
+        app.world_mut(),
+        name,
+        &moving_circles::run::Progress::default(),
+    );
+    eprintln!(
+        "{text}: deepest {deepest:e}, asleep {asleep}, pair collisions {}",
+        report.pair_collisions
+    );
+    assert!(asleep, "{text}: not asleep after 10 s");
+    assert!(deepest <= 1e-9, "{text}: overlap {deepest}");
+    assert_eq!((report.escaped, report.non_finite), (0, 0), "{text}");
+    assert_eq!(report.budget_exhausted, 0, "{text}: ran out of events");
+    report
+}
+
 #[test]
 fn a_heap_falls_settles_and_sleeps_with_no_overlap_under_the_event_driven_solvers() {
     for solver in ["exact", "swept"] {
@@ -147,29 +177,7 @@ fn a_heap_falls_settles_and_sleeps_with_no_overlap_under_the_event_driven_solver
               effects: (gravity: (0.0, -9.81), restitution: 0.5, wall_restitution: 0.5),
               spawn: (count: 60, radius: (0.2, 0.4), speed: (0.0, 1.0), seed: 6))"
         );
-        let config = Scene::parse(&heap, "heap.ron")
-            .and_then(|s| s.to_config("heap.ron"))
-            .unwrap();
-        let mut app = create_app(config);
-        let mut deepest = 0.0f64;
-        for _ in 0..10 * 60 {
-            step(&mut app, 1);
-            deepest = deepest.max(overlap(&mut app).max);
-        }
-        let (asleep, _) = settled(&mut app);
-        let report = moving_circles::run::Report::new(
-            app.world_mut(),
-            "heap.ron",
-            &moving_circles::run::Progress::default(),
-        );
-        eprintln!(
-            "{solver}: deepest {deepest:e}, asleep {asleep}, budget {}",
-            report.budget_exhausted
-        );
-        assert!(asleep, "{solver}: the heap is not asleep after 10 s");
-        assert!(deepest <= 1e-9, "{solver}: overlap {deepest}");
-        assert_eq!((report.escaped, report.non_finite), (0, 0), "{solver}");
-        assert_eq!(report.budget_exhausted, 0, "{solver}: ran out of events");
+        drops_and_sleeps(&heap, "heap.ron");
     }
 }
 
@@ -186,28 +194,9 @@ fn a_pile_forming_costs_a_few_hundred_hits_a_circle_under_the_event_driven_solve
               effects: (gravity: (0.0, -9.81), restitution: 0.5, wall_restitution: 0.5),
               spawn: (count: 200, radius: (0.5, 1.0), speed: (0.0, 0.0), seed: 3))"
         );
-        let config = Scene::parse(&pile, "pile.ron")
-            .and_then(|s| s.to_config("pile.ron"))
-            .unwrap();
-        let mut app = create_app(config);
-        let mut deepest = 0.0f64;
-        for _ in 0..10 * 60 {
-            step(&mut app, 1);
-            deepest = deepest.max(overlap(&mut app).max);
-        }
-        let (asleep, _) = settled(&mut app);
-        let report = moving_circles::run::Report::new(
-            app.world_mut(),
-            "pile.ron",
-            &moving_circles::run::Progress::default(),
-        );
+        let report = drops_and_sleeps(&pile, "pile.ron");
         let per_circle = report.pair_collisions as f64 / 200.0;
-        eprintln!("{solver}: {per_circle} pair collisions a circle, deepest {deepest:e}");
-        assert!(asleep, "{solver}: the pile is not asleep after 10 s");
-        assert!(deepest <= 1e-9, "{solver}: overlap {deepest}");
         assert!(per_circle <= 400.0, "{solver}: {per_circle} hits a circle");
-        assert_eq!((report.escaped, report.non_finite), (0, 0), "{solver}");
-        assert_eq!(report.budget_exhausted, 0, "{solver}: ran out of events");
     }
 }
 
