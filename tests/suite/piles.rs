@@ -201,6 +201,34 @@ fn a_pile_forming_costs_a_few_hundred_hits_a_circle_under_the_event_driven_solve
 }
 
 #[test]
+fn a_circle_at_rest_just_above_a_peg_lands_on_it_under_the_event_driven_solvers() {
+    // Nothing moves when the first step's engine is built, but the ball falls: it must look at
+    // the peg then, or it sinks into it within the step (1 mm in 14 ms, inside the first one).
+    for solver in ["exact", "swept"] {
+        let text = format!(
+            "(solver: \"{solver}\", arena: (size: (4.0, 4.0)),
+              effects: (gravity: (0.0, -9.81), restitution: 0.5, wall_restitution: 0.5),
+              circles: [(position: (0.0, 0.0), radius: 0.5, immovable: true),
+                        (position: (0.0, 1.001), radius: 0.5)])"
+        );
+        let config = Scene::parse(&text, "peg.ron")
+            .and_then(|s| s.to_config("peg.ron"))
+            .unwrap();
+        let mut app = create_app(config);
+        for k in 0..60 {
+            step(&mut app, 1);
+            let deepest = overlap(&mut app).max;
+            assert!(
+                deepest <= 1e-9,
+                "{solver}, step {k}: sunk {deepest} into the peg"
+            );
+        }
+        let ball = top(&snapshot(app.world_mut()));
+        assert!(ball.y >= 1.0 - 1e-9, "{solver}: the ball fell to {ball}");
+    }
+}
+
+#[test]
 fn the_course_solvers_cannot_hold_a_stack_but_keep_it_inside_and_finite() {
     // What `discrete` and `substeps=4` promise on a pile: nothing escapes or turns non-finite,
     // and the overlap stays bounded; the column sinks into itself (measured: 0.62 radii per
