@@ -23,6 +23,14 @@ fn scene(name: &str, solver: &str) -> App {
     create_app(config)
 }
 
+/// The app of the scene written out in `text`, as if read from a file `name`.
+fn written(text: &str, name: &str) -> App {
+    let config = Scene::parse(text, name)
+        .and_then(|s| s.to_config(name))
+        .unwrap_or_else(|e| panic!("{e}"));
+    create_app(config)
+}
+
 /// The deepest overlap among the circles now, in smaller radii.
 fn overlap(app: &mut App) -> Overlaps {
     let arena = *app.world().resource::<Arena>();
@@ -142,10 +150,7 @@ fn the_column_and_the_pyramid_stand_exactly_and_sleep_under_the_event_driven_sol
 /// promise a pile: asleep, no overlap beyond rounding after any step, nothing escaped or
 /// non-finite, the event budget never out. Returns the run's report.
 fn drops_and_sleeps(text: &str, name: &str) -> moving_circles::run::Report {
-    let config = Scene::parse(text, name)
-        .and_then(|s| s.to_config(name))
-        .unwrap();
-    let mut app = create_app(config);
+    let mut app = written(text, name);
     let mut deepest = 0.0f64;
     for _ in 0..10 * 60 {
         step(&mut app, 1);
@@ -211,10 +216,7 @@ fn a_circle_at_rest_just_above_a_peg_lands_on_it_under_the_event_driven_solvers(
               circles: [(position: (0.0, 0.0), radius: 0.5, immovable: true),
                         (position: (0.0, 1.001), radius: 0.5)])"
         );
-        let config = Scene::parse(&text, "peg.ron")
-            .and_then(|s| s.to_config("peg.ron"))
-            .unwrap();
-        let mut app = create_app(config);
+        let mut app = written(&text, "peg.ron");
         for k in 0..60 {
             step(&mut app, 1);
             let deepest = overlap(&mut app).max;
