@@ -98,8 +98,8 @@ pub fn falling_pair_time(dp: DVec2, dv: DVec2, da: DVec2, sigma: f64, horizon: f
     // The gap closes no faster than the relative speed and acceleration allow (with a margin
     // far above the rounding of the distance and the reach, so that no time sooner than the
     // horizon is ever ruled out).
+    let distance = dp.length();
     if horizon.is_finite() {
-        let distance = dp.length();
         let reach = dv.length() * horizon + a.length() * horizon * horizon;
         let margin = 1e-9 * (distance + sigma + reach);
         if distance - sigma - reach > margin {
@@ -126,7 +126,6 @@ pub fn falling_pair_time(dp: DVec2, dv: DVec2, da: DVec2, sigma: f64, horizon: f
     // horizon. Along the axes (a pair side by side drifting apart, a peg above the top of the
     // arc) and along the line between them now.
     let apart = |u: DVec2| stays_beyond(u.dot(dp), u.dot(dv), u.dot(a), sigma);
-    let distance = dp.length();
     if [DVec2::X, DVec2::NEG_X, DVec2::Y, DVec2::NEG_Y]
         .into_iter()
         .any(apart)
