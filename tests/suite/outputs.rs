@@ -13,6 +13,11 @@ fn temp_dir(name: &str) -> PathBuf {
     crate::common::binary::scratch_dir("outputs", name)
 }
 
+/// Two steps of `scene` with `flag` (an output) naming `path`, under the memory bound.
+fn two_steps_writing(scene: &str, flag: &str, path: &str) -> std::process::Output {
+    under_one_gib(&["run", "--scene", scene, "--steps", "2", flag, path])
+}
+
 #[test]
 fn an_output_never_replaces_the_runs_own_input() {
     let dir = temp_dir("inputs");
@@ -21,7 +26,7 @@ fn an_output_never_replaces_the_runs_own_input() {
     std::fs::write(&scene, text).unwrap();
     let scene = scene.to_str().unwrap();
     for flag in ["--report", "--dump", "--checkpoint"] {
-        let out = under_one_gib(&["run", "--scene", scene, "--steps", "2", flag, scene]);
+        let out = two_steps_writing(scene, flag, scene);
         assert_refused(&out, &[&format!("{flag} names the input of --scene")]);
     }
     assert_eq!(
@@ -32,15 +37,7 @@ fn an_output_never_replaces_the_runs_own_input() {
     // A resumed run may write its checkpoint back over the one it resumed, nothing else.
     let checkpoint = dir.join("c.ckpt");
     let checkpoint = checkpoint.to_str().unwrap();
-    let out = under_one_gib(&[
-        "run",
-        "--scene",
-        scene,
-        "--steps",
-        "2",
-        "--checkpoint",
-        checkpoint,
-    ]);
+    let out = two_steps_writing(scene, "--checkpoint", checkpoint);
     assert!(out.status.success(), "{}", stderr(&out));
     let again = ["run", "--resume", checkpoint, "--steps", "2"];
     let out = under_one_gib(&[&again[..], &["--checkpoint", checkpoint]].concat());
@@ -82,15 +79,7 @@ fn an_output_name_too_long_for_its_temporary_file_is_refused_before_the_run() {
     // 239 bytes is the longest name whose temporary file (16 bytes more) a file system takes.
     for (length, ok) in [(239, true), (240, false), (255, false)] {
         let report = dir.join("r".repeat(length));
-        let out = under_one_gib(&[
-            "run",
-            "--scene",
-            scene,
-            "--steps",
-            "2",
-            "--report",
-            report.to_str().unwrap(),
-        ]);
+        let out = two_steps_writing(scene, "--report", report.to_str().unwrap());
         let err = stderr(&out);
         assert_eq!(out.status.success(), ok, "{length} bytes: {err}");
         if !ok {

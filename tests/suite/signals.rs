@@ -52,6 +52,25 @@ fn start_long_run(dir: &Path) -> Child {
     child
 }
 
+/// The command for `steps` steps of the scene `scene_text` (written into `dir`) with a report
+/// over a file that holds "old", and that report's path: a run a signal ends before it steps
+/// must leave it so.
+fn run_over_old_report(dir: &Path, scene_text: &str, steps: u64) -> (Command, PathBuf) {
+    let (scene, report) = (dir.join("scene.ron"), dir.join("r.json"));
+    std::fs::write(&scene, scene_text).unwrap();
+    std::fs::write(&report, "old").unwrap();
+    let run = command(&[
+        "run",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--steps",
+        &steps.to_string(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    (run, report)
+}
+
 fn signal(child: &Child, name: &str) {
     let status = Command::new("kill")
         .args([&format!("-{name}"), &child.id().to_string()])
@@ -149,22 +168,12 @@ fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
 /// it ends within a second writing nothing.
 fn signalled_while_placing(scene_text: &str, placing: &str) {
     let dir = temp_dir("placing");
-    let (scene, report) = (dir.join("big.ron"), dir.join("r.json"));
-    std::fs::write(&scene, scene_text).unwrap();
-    std::fs::write(&report, "old").unwrap();
-    let mut child = command(&[
-        "run",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--steps",
-        "10",
-        "--report",
-        report.to_str().unwrap(),
-    ])
-    .stdout(Stdio::piped())
-    .stderr(Stdio::piped())
-    .spawn()
-    .unwrap();
+    let (mut run, report) = run_over_old_report(&dir, scene_text, 10);
+    let mut child = run
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
     // The run says it is placing them, then places them: the signal comes while it does.
     let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
     let mut said = String::new();
@@ -196,28 +205,14 @@ fn signalled_while_placing(scene_text: &str, placing: &str) {
 #[test]
 fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
     let dir = temp_dir("twice");
-    let report = dir.join("r.json");
-    std::fs::write(&report, "old").unwrap();
     // Placing a million circles takes seconds: both signals arrive before the first step.
-    let scene = dir.join("million.ron");
-    std::fs::write(
-        &scene,
-        "(arena: (size: (1000.0, 1000.0)), spawn: (count: 1000000, radius: (0.1, 0.1)))",
-    )
-    .unwrap();
-    let mut child = command(&[
-        "run",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--steps",
-        "100",
-        "--report",
-        report.to_str().unwrap(),
-    ])
-    .stdout(Stdio::null())
-    .stderr(Stdio::null())
-    .spawn()
-    .unwrap();
+    let million = "(arena: (size: (1000.0, 1000.0)), spawn: (count: 1000000, radius: (0.1, 0.1)))";
+    let (mut run, report) = run_over_old_report(&dir, million, 100);
+    let mut child = run
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
     std::thread::sleep(Duration::from_millis(1000));
     signal(&child, "INT");
     std::thread::sleep(Duration::from_millis(100));
