@@ -1,13 +1,15 @@
 //! The engine `exact` keeps between steps ([`EngineState`], also what a checkpoint stores of
 //! it) and how the continuous step gathers the circles into it: kept as it is when nothing
-//! outside touched them, updated for the few that user code moved, steered or turned, rebuilt
-//! otherwise (and every step under `swept`), rough when the effects say so.
+//! outside touched them, updated for the few that user code moved, steered or turned
+//! ([`super::outside`]), rebuilt otherwise (and under `swept` in every step where something
+//! moves), rough when the effects say so.
 
 use bevy::ecs::entity::{EntityHashMap, EntityHashSet};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::engine::{EngineSnapshot, EventEngine, EventStats, Rest, Roughness};
+use super::outside::{moved_since, turning_of};
 use crate::arena::Arena;
 use crate::circle::CircleState;
 use crate::collision_layers::CircleFilters;
@@ -229,14 +231,19 @@ pub(super) fn gather_into_engine(
     let (solver, arena, effects, segments) = setup;
     let key = (arena, effects, solver);
     let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
+    // `swept` keeps only an engine in which nothing moves (a pile asleep) and no circle was
+    // moved, steered or turned from outside (a sleeper set turning wakes): a fresh one would be
+    // the same, and would come to the same end of the step.
+    let untouched = solver == Solver::Swept && circles.p1().is_empty() && circles.p4().is_empty();
+    let kept = |engine: &EventEngine| solver == Solver::Exact || untouched && engine.is_still();
     let reason = match (&mut state.engine, solver) {
-        (Some(_), Solver::Exact) if own.lost => {
+        (Some(e), _) if kept(e) && own.lost => {
             "a circle lost its restitution or moment of inertia, or its layers changed"
         }
-        (Some(_), Solver::Exact) if state.reordered => "circles moved between archetypes",
-        (Some(_), Solver::Exact) if state.stopped => "a stop request ended the last step early",
-        (Some(engine), Solver::Exact)
-            if state.setup == Some(key) && state.segments == *segments =>
+        (Some(e), _) if kept(e) && state.reordered => "circles moved between archetypes",
+        (Some(e), _) if kept(e) && state.stopped => "a stop request ended the last step early",
+        (Some(engine), _)
+            if kept(engine) && state.setup == Some(key) && state.segments == *segments =>
         {
             let mut changed: Vec<Entity> = circles.p1().iter().collect();
             let turned = match engine.roughness().is_smooth() {
@@ -282,7 +289,7 @@ pub(super) fn gather_into_engine(
             }
         }
         (_, Solver::Exact) => "new solver, arena, segment walls or effects",
-        _ => "swept builds every step",
+        _ => "swept builds every step something moves",
     };
     if solver == Solver::Exact {
         debug!("exact engine: rebuilt ({reason})");
@@ -362,83 +369,6 @@ pub(super) fn gather_into_engine(
         state.segments = segments.clone();
     }
     state.rebuilds += 1;
-}
-
-/// What user code did to one circle of a kept engine since it last wrote it back.
-struct Moved {
-    index: usize,
-    /// Moved or steered it: its new position and velocity.
-    motion: Option<(DVec2, DVec2)>,
-    /// Turned it (in a rough engine): its new spin and angle.
-    turn: Option<(f64, f64)>,
-}
-
-/// How one circle turns, as its components say: spin and angle (0 for what it lacks), and its
-/// own moment of inertia.
-#[derive(Clone, Copy)]
-struct Turning {
-    turn: (f64, f64),
-    inertia: Option<f64>,
-}
-
-/// Of the `changed` circles (written since the kept `engine` last wrote them, or spawned), with
-/// how each turns now (in a rough engine; none in a smooth one), those user code moved,
-/// steered or turned; or why the engine cannot be kept (a circle came, went, or changed its
-/// radius, mass, restitution or moment of inertia). `known` holds how many circles the engine
-/// has and each one's index by entity.
-fn moved_since(
-    engine: &EventEngine,
-    known: (usize, &EntityHashMap<usize>),
-    (changed, turned): (&[Entity], &[Turning]),
-    circles: &SolverCircles,
-    restitution_of: impl Fn(Option<&Restitution>) -> f64,
-) -> Result<Vec<Moved>, &'static str> {
-    let (count, index) = known;
-    if circles.iter().len() != count {
-        return Err("circles were spawned or despawned");
-    }
-    let mut moved = Vec::new();
-    for (k, &entity) in changed.iter().enumerate() {
-        let (Some(&i), Ok((_, p, v, r, m, e, ..))) = (index.get(&entity), circles.get(entity))
-        else {
-            return Err("circles were spawned or despawned");
-        };
-        if engine.body(i) != (r.0, m.inverse(), restitution_of(e)) {
-            return Err("a radius, mass or restitution changed");
-        }
-        let motion = ((p.0, v.0) != (engine.position(i), engine.velocity(i))).then_some((p.0, v.0));
-        let turning = turned.get(k);
-        if turning.is_some_and(|t| t.inertia != engine.own_inertia(i)) {
-            return Err("a moment of inertia changed");
-        }
-        let turn = turning
-            .map(|t| t.turn)
-            .filter(|&t| Some(t) != engine.turn(i));
-        if motion.is_some() || turn.is_some() {
-            moved.push(Moved {
-                index: i,
-                motion,
-                turn,
-            });
-        }
-    }
-    Ok(moved)
-}
-
-/// How each of `entities` turns now.
-fn turning_of(spins: &SpinCircles, entities: impl Iterator<Item = Entity>) -> Vec<Turning> {
-    entities
-        .map(|entity| match spins.get(entity) {
-            Ok((spin, angle, _, own, _)) => Turning {
-                turn: (spin.map_or(0.0, |w| w.0), angle.map_or(0.0, |a| a.0)),
-                inertia: own.map(|i| i.0),
-            },
-            Err(_) => Turning {
-                turn: (0.0, 0.0),
-                inertia: None,
-            },
-        })
-        .collect()
 }
 
 /// The roughness of hits `effects` call for.

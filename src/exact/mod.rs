@@ -5,6 +5,10 @@
 //! - `swept` builds a fresh engine from the current state every step and resolves that step's
 //!   hits in time order, with a bounded number of events per step ([`EventBudget`]);
 //!   past the bound the rest of the step is free flight and the missed hits resolve next step.
+//!   A pile asleep, where nothing moves and nothing outside touched a circle, keeps its engine.
+//!
+//! Under either, a step in which nothing moves (a pile asleep under gravity) advances nothing
+//! and costs a look at each circle.
 //!
 //! Both handle walls, periodic edges and collisions themselves (trading spin when the effects
 //! make hits rough, `engine::Roughness`), so they run in the
@@ -17,6 +21,7 @@
 pub mod engine;
 pub mod fall;
 mod keep;
+mod outside;
 pub mod pack;
 pub mod queue;
 pub mod roots;
@@ -187,16 +192,22 @@ fn continuous_step(
         own,
         &mut circles,
     );
-    if state.engine.is_none() {
+    let Some(engine) = state.engine.as_ref() else {
         // A stop gave up the build: this step moves, turns and wakes nothing.
         return;
+    };
+    // When nothing moves (a pile asleep under gravity), no event can come: the engine's clock
+    // stays where it is, and with it the sleepers' timers, which would otherwise be written back
+    // to every circle each step (`swept` keeps such an engine for the next step, and a fresh one
+    // would match it). What is written back below then writes nothing.
+    if effects.gravity.is_none() || !engine.is_still() {
+        advance_engine(
+            (*solver, dt.0, *budget, stop.as_deref()),
+            &mut state,
+            (&mut counted.pairs, &mut counted.walls),
+            messages,
+        );
     }
-    advance_engine(
-        (*solver, dt.0, *budget, stop.as_deref()),
-        &mut state,
-        (&mut counted.pairs, &mut counted.walls),
-        messages,
-    );
     write_back(&mut state, &mut circles.p0());
     counted.sleeping.count = write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count);
     if !write_back_turning(&state, &mut circles.p3()) {

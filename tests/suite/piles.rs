@@ -187,6 +187,41 @@ fn a_heap_falls_settles_and_sleeps_with_no_overlap_under_the_event_driven_solver
 }
 
 #[test]
+fn a_heap_asleep_under_swept_builds_no_engine_until_something_moves() {
+    use moving_circles::exact::EngineState;
+    let heap = "(solver: \"swept\", arena: (size: (3.0, 8.0)),
+        effects: (gravity: (0.0, -9.81), restitution: 0.5, wall_restitution: 0.5),
+        spawn: (count: 60, radius: (0.2, 0.4), speed: (0.0, 1.0), seed: 6))";
+    let mut app = written(heap, "heap.ron");
+    step(&mut app, 10 * 60);
+    assert!(settled(&mut app).0, "not asleep after 10 s");
+    let rebuilds = |app: &App| app.world().resource::<EngineState>().rebuilds;
+    let (before, built) = (snapshot(app.world_mut()), rebuilds(&app));
+    step(&mut app, 60);
+    assert_eq!(rebuilds(&app), built, "a pile asleep was built again");
+    assert!(settled(&mut app).0, "woke with nothing moving");
+    let after = snapshot(app.world_mut());
+    assert!(
+        before.iter().zip(&after).all(|(a, b)| a == b),
+        "a circle moved"
+    );
+    // A write from outside: the next step builds anew, and the circle set moving moves.
+    let mut circles = app.world_mut().query::<&mut Velocity>();
+    let mut first = circles.iter_mut(app.world_mut()).next().unwrap();
+    first.0 = DVec2::new(0.0, 2.0);
+    step(&mut app, 1);
+    assert_eq!(rebuilds(&app), built + 1);
+    let moved = snapshot(app.world_mut());
+    assert!(
+        before
+            .iter()
+            .zip(&moved)
+            .any(|(a, b)| a.position != b.position),
+        "the circle set moving stayed"
+    );
+}
+
+#[test]
 fn a_pile_forming_costs_a_few_hundred_hits_a_circle_under_the_event_driven_solvers() {
     // `pile.ron` at a tenth of its width: 200 circles of radii 0.5 to 1 placed at random and
     // dropped at rest, restitution 0.5. As they land, circles pressed together trade hits

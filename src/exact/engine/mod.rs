@@ -255,6 +255,15 @@ impl EventEngine {
         self.vel_at(i, self.now)
     }
 
+    /// Whether nothing in the engine moves: no circle has a velocity, falls or turns, and radii
+    /// do not grow (a pile asleep). No event can then come, however far it is advanced.
+    pub fn is_still(&self) -> bool {
+        let turning = |i: usize| self.turn(i).is_some_and(|(spin, _)| spin != 0.0);
+        self.growth == 0.0
+            && (0..self.len())
+                .all(|i| !self.falls[i] && self.motion[i].vel == DVec2::ZERO && !turning(i))
+    }
+
     /// Whether circle `i` sleeps.
     pub fn is_asleep(&self, i: usize) -> bool {
         self.asleep[i]

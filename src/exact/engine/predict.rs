@@ -367,8 +367,7 @@ impl EventEngine {
     /// its neighbours: each gets no pair, as looking would have found, and its other events
     /// are asked as always.
     pub(super) fn predict_all_until(&mut self, stop: impl Fn() -> bool) -> bool {
-        let still = self.growth == 0.0
-            && (0..self.len()).all(|i| !self.falls[i] && self.motion[i].vel == DVec2::ZERO);
+        let still = self.is_still();
         for i in 0..self.len() {
             if i % super::STOP_POLL_CIRCLES == 0 && stop() {
                 return false;
