@@ -255,13 +255,14 @@ fn integrate_positions(bodies: &mut Bodies, h: f64) {
     }
 }
 
-/// Applies impulse `j` along contact `c`'s normal (to `a` against it, to `b` along it).
-#[inline]
-fn apply(bodies: &mut Bodies, c: &Constraint, j: f64, work: &mut Work) {
+/// Applies impulse `j` along contact `c`'s normal (to `a` against it, to `b` along it); `WALL`
+/// says whether `c` is a wall's (which has no `b`), so each kind of contact gets its own loop.
+#[inline(always)]
+fn apply<const WALL: bool>(bodies: &mut Bodies, c: &Constraint, j: f64, work: &mut Work) {
     let (wa, wb) = c.inv_mass;
     let p = c.normal * j;
     let a = c.a as usize;
-    if c.b == NONE {
+    if WALL {
         bodies.velocity[a] -= p * wa;
         return;
     }
@@ -285,22 +286,31 @@ fn warm_start<const TURNING: bool>(
     rows: &[TurningRow],
     work: &mut Work,
 ) {
-    for c in walls.iter_mut().chain(pairs.iter_mut()) {
-        if c.impulse > 0.0 {
-            apply(bodies, c, c.impulse, work);
-            c.total_impulse += c.impulse;
-        }
-        if TURNING && c.turn != NONE {
-            work.add(warm_start_turning(bodies, c, &rows[c.turn as usize]));
+    fn each<const TURNING: bool, const WALL: bool>(
+        bodies: &mut Bodies,
+        contacts: &mut [Constraint],
+        rows: &[TurningRow],
+        work: &mut Work,
+    ) {
+        for c in contacts {
+            if c.impulse > 0.0 {
+                apply::<WALL>(bodies, c, c.impulse, work);
+                c.total_impulse += c.impulse;
+            }
+            if TURNING && c.turn != NONE {
+                work.add(warm_start_turning(bodies, c, &rows[c.turn as usize]));
+            }
         }
     }
+    each::<TURNING, true>(bodies, walls, rows, work);
+    each::<TURNING, false>(bodies, pairs, rows, work);
 }
 
-/// The other side's position and velocity for contact `c`: a wall's anchor at rest, or `b`'s
-/// image.
-#[inline]
-fn other_side(bodies: &Bodies, c: &Constraint) -> (DVec2, DVec2) {
-    if c.b == NONE {
+/// The other side's position and velocity for contact `c` (a wall's if `WALL`): a wall's
+/// anchor at rest, or `b`'s image.
+#[inline(always)]
+fn other_side<const WALL: bool>(bodies: &Bodies, c: &Constraint) -> (DVec2, DVec2) {
+    if WALL {
         (c.anchor, DVec2::ZERO)
     } else {
         let b = c.b as usize;
@@ -308,10 +318,10 @@ fn other_side(bodies: &Bodies, c: &Constraint) -> (DVec2, DVec2) {
     }
 }
 
-/// One pass over the contacts. With `use_bias` an overlap is pushed out softly (at most at the
-/// contact's push speed); without it (the relax pass) only approach is stopped. Either way a
-/// gap still open lets the pair approach by as much as closes it within the substep: the
-/// speculative part that keeps fast circles from tunnelling.
+/// One pass over the contacts, walls first. With `use_bias` an overlap is pushed out softly
+/// (at most at the contact's push speed); without it (the relax pass) only approach is
+/// stopped. Either way a gap still open lets the pair approach by as much as closes it within
+/// the substep: the speculative part that keeps fast circles from tunnelling.
 fn solve<const TURNING: bool>(
     bodies: &mut Bodies,
     (walls, pairs, rows): (&mut [Constraint], &mut [Constraint], &mut [TurningRow]),
@@ -319,29 +329,39 @@ fn solve<const TURNING: bool>(
     use_bias: bool,
     work: &mut Work,
 ) {
-    for c in walls.iter_mut().chain(pairs.iter_mut()) {
-        let a = c.a as usize;
-        let (pb, vb) = other_side(bodies, c);
-        let s = c.separation(bodies.position[a], pb);
-        let (bias, soft) = if s > 0.0 {
-            (s * inv_h, Softness::RIGID)
-        } else if use_bias {
-            ((c.soft.bias_rate * s).max(-c.push), c.soft)
-        } else {
-            (0.0, Softness::RIGID)
-        };
-        let vn = (vb - bodies.velocity[a]).dot(c.normal);
-        c.approach = c.approach.max(-vn);
-        let j = -c.normal_mass * soft.mass_scale * (vn + bias) - soft.impulse_scale * c.impulse;
-        let total = (c.impulse + j).max(0.0);
-        let j = total - c.impulse;
-        c.impulse = total;
-        c.total_impulse += j;
-        apply(bodies, c, j, work);
-        if TURNING && c.turn != NONE {
-            work.add(solve_turning(bodies, c, &mut rows[c.turn as usize]));
+    fn each<const TURNING: bool, const WALL: bool>(
+        bodies: &mut Bodies,
+        (contacts, rows): (&mut [Constraint], &mut [TurningRow]),
+        inv_h: f64,
+        use_bias: bool,
+        work: &mut Work,
+    ) {
+        for c in contacts {
+            let a = c.a as usize;
+            let (pb, vb) = other_side::<WALL>(bodies, c);
+            let s = c.separation(bodies.position[a], pb);
+            let (bias, soft) = if s > 0.0 {
+                (s * inv_h, Softness::RIGID)
+            } else if use_bias {
+                ((c.soft.bias_rate * s).max(-c.push), c.soft)
+            } else {
+                (0.0, Softness::RIGID)
+            };
+            let vn = (vb - bodies.velocity[a]).dot(c.normal);
+            c.approach = c.approach.max(-vn);
+            let j = -c.normal_mass * soft.mass_scale * (vn + bias) - soft.impulse_scale * c.impulse;
+            let total = (c.impulse + j).max(0.0);
+            let j = total - c.impulse;
+            c.impulse = total;
+            c.total_impulse += j;
+            apply::<WALL>(bodies, c, j, work);
+            if TURNING && c.turn != NONE {
+                work.add(solve_turning(bodies, c, &mut rows[c.turn as usize]));
+            }
         }
     }
+    each::<TURNING, true>(bodies, (walls, rows), inv_h, use_bias, work);
+    each::<TURNING, false>(bodies, (pairs, rows), inv_h, use_bias, work);
 }
 
 /// Bounces the contacts that began to push this step (a hit, not a contact that rests from
@@ -356,21 +376,25 @@ fn restitution(
     (walls, pairs): (&mut [Constraint], &mut [Constraint]),
     work: &mut Work,
 ) {
-    for c in walls.iter_mut().chain(pairs.iter_mut()) {
-        let resting = c.was_touching || c.total_impulse == 0.0;
-        if resting || c.restitution == 0.0 || c.relative_velocity > -c.threshold {
-            continue;
+    fn each<const WALL: bool>(bodies: &mut Bodies, contacts: &mut [Constraint], work: &mut Work) {
+        for c in contacts {
+            let resting = c.was_touching || c.total_impulse == 0.0;
+            if resting || c.restitution == 0.0 || c.relative_velocity > -c.threshold {
+                continue;
+            }
+            let a = c.a as usize;
+            let (_, vb) = other_side::<WALL>(bodies, c);
+            let vn = (vb - bodies.velocity[a]).dot(c.normal);
+            let j = -c.normal_mass * (vn + c.restitution * c.relative_velocity);
+            let total = (c.impulse + j).max(0.0);
+            let j = total - c.impulse;
+            c.impulse = total;
+            c.total_impulse += j;
+            apply::<WALL>(bodies, c, j, work);
         }
-        let a = c.a as usize;
-        let (_, vb) = other_side(bodies, c);
-        let vn = (vb - bodies.velocity[a]).dot(c.normal);
-        let j = -c.normal_mass * (vn + c.restitution * c.relative_velocity);
-        let total = (c.impulse + j).max(0.0);
-        let j = total - c.impulse;
-        c.impulse = total;
-        c.total_impulse += j;
-        apply(bodies, c, j, work);
     }
+    each::<true>(bodies, walls, work);
+    each::<false>(bodies, pairs, work);
 }
 
 /// Puts back a centre that a push or a fast step left outside the arena (walls), or wraps it
