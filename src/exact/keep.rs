@@ -196,13 +196,20 @@ pub(super) type TurnedCircles<'w, 's> = Query<
     ),
 >;
 
-/// The circles as the step sees them, one view at a time: all, changed, sleep, spin, turned.
+/// The circles whose [`Sleep`] anything but [`continuous_step`] wrote to since it last ran (a
+/// user waking a circle or putting it to sleep, everyone woken by a change of the effects, or
+/// a checkpoint put back).
+pub(super) type ResleptCircles<'w, 's> = Query<'w, 's, (), (With<Radius>, Changed<Sleep>)>;
+
+/// The circles as the step sees them, one view at a time: all, changed, sleep, spin, turned,
+/// their sleep written from outside.
 pub(super) type EngineViews = (
     SolverCircles<'static, 'static>,
     ChangedCircles<'static, 'static>,
     Query<'static, 'static, &'static mut Sleep>,
     SpinCircles<'static, 'static>,
     TurnedCircles<'static, 'static>,
+    ResleptCircles<'static, 'static>,
 );
 
 /// What circles have of their own beyond their motion, as the continuous step gathers it.
@@ -215,12 +222,16 @@ pub(super) struct Own<'a> {
     pub restitution: bool,
     /// Each circle's layers.
     pub filters: &'a CircleFilters<'a, 'a>,
+    /// Whether a circle's [`Sleep`] was written from outside since the last step (a user
+    /// waking it or putting it to sleep; everyone woken by a change of the effects).
+    pub slept: bool,
 }
 
 /// Keeps the `exact` engine if nothing but the engine itself changed the circles since the last
 /// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
-/// paddle); otherwise (and always for `swept`) builds a fresh one from the circles, with their
-/// own restitutions and layers. Says which in a debug log. A build that `stop` ends leaves no
+/// paddle); otherwise builds a fresh one from the circles, with their own restitutions and
+/// layers. `swept` keeps its engine only while nothing in it moves and nothing outside touched
+/// a circle, and builds a fresh one otherwise. Says which in a debug log. A build that `stop` ends leaves no
 /// engine: the step then moves nothing and counts in `budget_exhausted`.
 pub(super) fn gather_into_engine(
     (setup, stop): ((Solver, Arena, Effects, &Segments), Option<&StopRequest>),
@@ -232,19 +243,22 @@ pub(super) fn gather_into_engine(
     let key = (arena, effects, solver);
     let restitution_of = |own: Option<&Restitution>| own.map_or(effects.restitution, |e| e.0);
     // `swept` keeps only an engine in which nothing moves (a pile asleep) and no circle was
-    // moved, steered or turned from outside (a sleeper set turning wakes): a fresh one would be
-    // the same, and would come to the same end of the step.
-    let untouched = solver == Solver::Swept && circles.p1().is_empty() && circles.p4().is_empty();
-    let kept = |engine: &EventEngine| solver == Solver::Exact || untouched && engine.is_still();
+    // moved, steered, turned (a sleeper set turning wakes) or woken from outside: a fresh one
+    // would be the same, and would come to the same end of the step.
+    let kept = match (&state.engine, solver) {
+        (None, _) => false,
+        (Some(engine), Solver::Swept) => {
+            !own.slept && engine.is_still() && circles.p1().is_empty() && circles.p4().is_empty()
+        }
+        (Some(_), _) => true,
+    };
     let reason = match (&mut state.engine, solver) {
-        (Some(e), _) if kept(e) && own.lost => {
+        (Some(_), _) if kept && own.lost => {
             "a circle lost its restitution or moment of inertia, or its layers changed"
         }
-        (Some(e), _) if kept(e) && state.reordered => "circles moved between archetypes",
-        (Some(e), _) if kept(e) && state.stopped => "a stop request ended the last step early",
-        (Some(engine), _)
-            if kept(engine) && state.setup == Some(key) && state.segments == *segments =>
-        {
+        (Some(_), _) if kept && state.reordered => "circles moved between archetypes",
+        (Some(_), _) if kept && state.stopped => "a stop request ended the last step early",
+        (Some(engine), _) if kept && state.setup == Some(key) && state.segments == *segments => {
             let mut changed: Vec<Entity> = circles.p1().iter().collect();
             let turned = match engine.roughness().is_smooth() {
                 true => Vec::new(),
@@ -257,8 +271,8 @@ pub(super) fn gather_into_engine(
                 }
             };
             let all = circles.p0();
-            // Built the first time a kept engine needs it, so `swept` (which builds an engine
-            // every step) never does.
+            // Built the first time a kept engine needs it, so `swept` (which keeps an engine
+            // only while nothing moves or is touched) never does.
             if !changed.is_empty() && state.index.is_empty() {
                 let entities = state.entities.iter().enumerate();
                 state.index = entities.map(|(i, &e)| (e, i)).collect();

@@ -7,8 +7,8 @@
 //!   past the bound the rest of the step is free flight and the missed hits resolve next step.
 //!   A pile asleep, where nothing moves and nothing outside touched a circle, keeps its engine.
 //!
-//! Under either, a step in which nothing moves (a pile asleep under gravity) advances nothing
-//! and costs a look at each circle.
+//! Under either, a step in which nothing moves (a pile asleep under gravity) has no event and
+//! writes no circle back.
 //!
 //! Both handle walls, periodic edges and collisions themselves (trading spin when the effects
 //! make hits rough, `engine::Roughness`), so they run in the
@@ -181,10 +181,12 @@ fn continuous_step(
         stop,
     } = setup;
     let (own_restitution, filters) = own;
+    let slept = !circles.p5().is_empty();
     let own = Own {
         lost: lost.any() || !relayered.is_empty(),
         restitution: !own_restitution.is_empty(),
         filters: &filters,
+        slept,
     };
     gather_into_engine(
         ((*solver, *arena, *effects, &segments), stop.as_deref()),
@@ -196,20 +198,24 @@ fn continuous_step(
         // A stop gave up the build: this step moves, turns and wakes nothing.
         return;
     };
-    // When nothing moves (a pile asleep under gravity), no event can come: the engine's clock
-    // stays where it is, and with it the sleepers' timers, which would otherwise be written back
-    // to every circle each step (`swept` keeps such an engine for the next step, and a fresh one
-    // would match it). What is written back below then writes nothing.
-    if effects.gravity.is_none() || !engine.is_still() {
-        advance_engine(
-            (*solver, dt.0, *budget, stop.as_deref()),
-            &mut state,
-            (&mut counted.pairs, &mut counted.walls),
-            messages,
-        );
-    }
+    // When nothing moves (a pile asleep under gravity), the step changes nothing but the
+    // sleepers' timers; they are not written back to every circle each step, so a circle's
+    // `Sleep` holds the time it had stayed when the pile fell still (`swept` keeps such an engine
+    // for the next step, and a fresh one built from those timers would match it). A `Sleep`
+    // written from outside is written over as in any step (under `exact`, whose kept engine
+    // does not hear it; `swept` built its engine anew from it).
+    let still = effects.gravity.is_some() && engine.is_still() && !slept;
+    advance_engine(
+        (*solver, dt.0, *budget, stop.as_deref()),
+        &mut state,
+        (&mut counted.pairs, &mut counted.walls),
+        messages,
+    );
     write_back(&mut state, &mut circles.p0());
-    counted.sleeping.count = write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count);
+    counted.sleeping.count = match (still, state.engine.as_ref()) {
+        (true, Some(engine)) => (0..engine.len()).filter(|&i| engine.is_asleep(i)).count(),
+        _ => write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count),
+    };
     if !write_back_turning(&state, &mut circles.p3()) {
         turn_circles(&mut circles.p3(), dt.0); // smooth circles trade no spin
     }

@@ -205,7 +205,18 @@ fn a_heap_asleep_under_swept_builds_no_engine_until_something_moves() {
         before.iter().zip(&after).all(|(a, b)| a == b),
         "a circle moved"
     );
-    // A write from outside: the next step builds anew, and the circle set moving moves.
+    // A circle woken from outside: the next step builds anew from it.
+    let mut sleeps = app.world_mut().query::<&mut Sleep>();
+    sleeps.iter_mut(app.world_mut()).next().unwrap().asleep = false;
+    step(&mut app, 1);
+    assert_eq!(
+        rebuilds(&app),
+        built + 1,
+        "a circle woken from outside was not heard"
+    );
+    step(&mut app, 10);
+    let built = rebuilds(&app);
+    // A velocity written from outside: the next step builds anew, and the circle moves.
     let mut circles = app.world_mut().query::<&mut Velocity>();
     let mut first = circles.iter_mut(app.world_mut()).next().unwrap();
     first.0 = DVec2::new(0.0, 2.0);

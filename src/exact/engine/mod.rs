@@ -256,7 +256,8 @@ impl EventEngine {
     }
 
     /// Whether nothing in the engine moves: no circle has a velocity, falls or turns, and radii
-    /// do not grow (a pile asleep). No event can then come, however far it is advanced.
+    /// do not grow (a pile asleep). No collision, wall hit or cell crossing can then come,
+    /// however far it is advanced (only stale pair events, which move nothing).
     pub fn is_still(&self) -> bool {
         let turning = |i: usize| self.turn(i).is_some_and(|(spin, _)| spin != 0.0);
         self.growth == 0.0

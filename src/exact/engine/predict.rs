@@ -362,10 +362,10 @@ impl EventEngine {
     /// [`STOP_POLL_CIRCLES`](super::STOP_POLL_CIRCLES) circles whether to give up; whether it
     /// predicted them all.
     ///
-    /// When nothing moves (no circle has a velocity or falls, and radii do not grow: a pile
-    /// asleep, which `swept` builds anew every step), no pair can meet, so no circle looks at
-    /// its neighbours: each gets no pair, as looking would have found, and its other events
-    /// are asked as always.
+    /// When nothing moves ([`EventEngine::is_still`]: a pile asleep, which `swept` builds anew
+    /// after something outside touched it), no pair can meet, so no circle looks at its
+    /// neighbours: each gets no pair, as looking would have found, and its other events are
+    /// asked as always.
     pub(super) fn predict_all_until(&mut self, stop: impl Fn() -> bool) -> bool {
         let still = self.is_still();
         for i in 0..self.len() {
