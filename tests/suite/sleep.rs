@@ -235,6 +235,28 @@ fn a_checkpoint_marking_a_circle_asleep_resumes_under_exact_without_gravity_to_a
 }
 
 #[test]
+fn a_heap_checkpointed_while_still_then_kicked_goes_on_as_the_run_does_under_the_event_driven_solvers()
+ {
+    // Half a second after the whole heap fell asleep nothing has moved for 30 steps: `swept`
+    // keeps its engine and neither solver writes the sleepers back. A checkpoint taken then,
+    // and the same kick given to the run and to the resumed one, must lead to the same heap.
+    for solver in ["swept", "exact"] {
+        let mut app = heap_with(solver, "");
+        until_asleep(&mut app, 20.0).expect("asleep");
+        step(&mut app, 30);
+        let kick = |app: &mut App| {
+            let mut circles = app.world_mut().query::<(&Position, &mut Velocity)>();
+            let mut top = circles
+                .iter_mut(app.world_mut())
+                .max_by(|a, b| a.0.0.y.total_cmp(&b.0.0.y))
+                .unwrap();
+            top.1.0 = DVec2::new(1.5, 2.0);
+        };
+        assert_resumes_through(&mut app, kick, 120, solver);
+    }
+}
+
+#[test]
 fn a_checkpoint_taken_after_your_code_wakes_a_sleeping_circle_resumes_as_the_run_goes_on() {
     // A game sets a sleeping circle moving (or turning) and takes a checkpoint before the next
     // step, which is the one that would wake it. Our reader refuses a circle asleep that moves

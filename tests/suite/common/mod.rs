@@ -235,6 +235,12 @@ pub type Named<F> = (&'static str, F);
 /// then runs both `steps` more: they must end at the same circles, bit for bit. `what` names
 /// the case in the messages.
 pub fn assert_resumes_as_the_run_goes_on(app: &mut App, steps: u64, what: &str) {
+    assert_resumes_through(app, |_| {}, steps, what);
+}
+
+/// [`assert_resumes_as_the_run_goes_on`], with `then` done to the run and to the resumed one
+/// right after the checkpoint (a kick from user code, say).
+pub fn assert_resumes_through(app: &mut App, then: impl Fn(&mut App), steps: u64, what: &str) {
     use moving_circles::checkpoint::Checkpoint;
     use moving_circles::circle::snapshot;
     use moving_circles::run::Progress;
@@ -243,6 +249,8 @@ pub fn assert_resumes_as_the_run_goes_on(app: &mut App, steps: u64, what: &str) 
     let (mut resumed, _) = Checkpoint::from_bytes(&bytes, "test.checkpoint")
         .and_then(|c| c.resume("test.checkpoint"))
         .unwrap_or_else(|e| panic!("{what}: our own checkpoint: {e}"));
+    then(app);
+    then(&mut resumed);
     step(app, steps);
     step(&mut resumed, steps);
     let (ran, went_on) = (snapshot(app.world_mut()), snapshot(resumed.world_mut()));
