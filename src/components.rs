@@ -177,8 +177,7 @@ impl Default for Tint {
 pub struct Sleep {
     /// Where the circle was when it last moved: it is at rest while it stays near this point.
     pub anchor: DVec2,
-    /// Seconds the circle has stayed near its anchor (under `swept` and `exact`, not counting
-    /// the steps in which nothing moved at all).
+    /// Seconds the circle has stayed near its anchor.
     pub slow_for: f64,
     /// Whether it sleeps now.
     pub asleep: bool,

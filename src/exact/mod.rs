@@ -5,10 +5,8 @@
 //! - `swept` builds a fresh engine from the current state every step and resolves that step's
 //!   hits in time order, with a bounded number of events per step ([`EventBudget`]);
 //!   past the bound the rest of the step is free flight and the missed hits resolve next step.
-//!   A pile asleep, where nothing moves and nothing outside touched a circle, keeps its engine.
-//!
-//! Under either, a step in which nothing moves (a pile asleep under gravity) has no event and
-//! writes no circle back.
+//!   A pile asleep under gravity, where nothing moves and nothing outside touched a circle,
+//!   keeps its engine, and a step of it writes back what a fresh engine would.
 //!
 //! Both handle walls, periodic edges and collisions themselves (trading spin when the effects
 //! make hits rough, `engine::Roughness`), so they run in the
@@ -198,24 +196,22 @@ fn continuous_step(
         // A stop gave up the build: this step moves, turns and wakes nothing.
         return;
     };
-    // When nothing moves (a pile asleep under gravity), the step changes nothing but the
-    // sleepers' timers; they are not written back to every circle each step, so a circle's
-    // `Sleep` holds the time it had stayed when the pile fell still (`swept` keeps such an engine
-    // for the next step, and a fresh one built from those timers would match it). A `Sleep`
-    // written from outside is written over as in any step (under `exact`, whose kept engine
-    // does not hear it; `swept` built its engine anew from it).
-    let still = effects.gravity.is_some() && engine.is_still() && !slept;
-    advance_engine(
-        (*solver, dt.0, *budget, stop.as_deref()),
-        &mut state,
-        (&mut counted.pairs, &mut counted.walls),
-        messages,
-    );
-    write_back(&mut state, &mut circles.p0());
-    counted.sleeping.count = match (still, state.engine.as_ref()) {
-        (true, Some(engine)) => (0..engine.len()).filter(|&i| engine.is_asleep(i)).count(),
-        _ => write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count),
-    };
+    if *solver == Solver::Swept && effects.gravity.is_some() && engine.is_still() {
+        // Nothing moves (a pile asleep): no event can come, and the engine, kept or fresh, is
+        // not advanced; the step writes back what a fresh engine advanced by it would.
+        write_back(&mut state, &mut circles.p0());
+        counted.sleeping.count = age_rest(&state, &mut circles.p2(), dt.0);
+    } else {
+        advance_engine(
+            (*solver, dt.0, *budget, stop.as_deref()),
+            &mut state,
+            (&mut counted.pairs, &mut counted.walls),
+            messages,
+        );
+        write_back(&mut state, &mut circles.p0());
+        counted.sleeping.count =
+            write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count);
+    }
     if !write_back_turning(&state, &mut circles.p3()) {
         turn_circles(&mut circles.p3(), dt.0); // smooth circles trade no spin
     }
@@ -279,6 +275,26 @@ fn write_back_sleep(
             && *s != now
         {
             *s = now;
+        }
+    }
+    asleep
+}
+
+/// What a fresh engine built from the circles as they are, in which nothing moves, writes back
+/// to their [`Sleep`] after a step of `dt` (so a kept one need not be advanced): each circle's
+/// time near its anchor grows by the step, worked out as that engine's [`Rest`] of it would be
+/// (`now - since` with `now = dt`, `since = -slow_for`), the rest stays. Returns how many sleep.
+///
+/// [`Rest`]: engine::Rest
+fn age_rest(state: &EngineState, sleep: &mut Query<&mut Sleep>, dt: f64) -> usize {
+    let mut asleep = 0;
+    for &entity in &state.entities {
+        if let Ok(mut s) = sleep.get_mut(entity) {
+            asleep += usize::from(s.asleep);
+            let slow_for = (dt - (-s.slow_for)).max(0.0);
+            if s.slow_for != slow_for {
+                s.slow_for = slow_for;
+            }
         }
     }
     asleep

@@ -237,13 +237,14 @@ fn a_checkpoint_marking_a_circle_asleep_resumes_under_exact_without_gravity_to_a
 #[test]
 fn a_heap_checkpointed_while_still_then_kicked_goes_on_as_the_run_does_under_the_event_driven_solvers()
  {
-    // Half a second after the whole heap fell asleep nothing has moved for 30 steps: `swept`
-    // keeps its engine and neither solver writes the sleepers back. A checkpoint taken then,
-    // and the same kick given to the run and to the resumed one, must lead to the same heap.
+    // Half a second after the whole heap fell asleep nothing has moved for 30 steps, and
+    // `swept` keeps its engine. A checkpoint taken then must lead to the same heap and the same
+    // sleepers' timers, left alone and after the same kick to the run and the resumed one.
     for solver in ["swept", "exact"] {
         let mut app = heap_with(solver, "");
         until_asleep(&mut app, 20.0).expect("asleep");
         step(&mut app, 30);
+        assert_resumes_as_the_run_goes_on(&mut app, 30, &format!("{solver}, still"));
         let kick = |app: &mut App| {
             let mut circles = app.world_mut().query::<(&Position, &mut Velocity)>();
             let mut top = circles

@@ -255,4 +255,14 @@ pub fn assert_resumes_through(app: &mut App, then: impl Fn(&mut App), steps: u64
     step(&mut resumed, steps);
     let (ran, went_on) = (snapshot(app.world_mut()), snapshot(resumed.world_mut()));
     assert_eq!(ran, went_on, "{what}: the resumed run goes elsewhere");
+    // Where each circle stands in coming to rest too (what the next checkpoint keeps).
+    let rest = |app: &mut App| -> Vec<Sleep> {
+        let mut sleep = app.world_mut().query_filtered::<&Sleep, With<Radius>>();
+        sleep.iter(app.world()).copied().collect()
+    };
+    assert_eq!(
+        rest(app),
+        rest(&mut resumed),
+        "{what}: the resumed run rests otherwise"
+    );
 }
