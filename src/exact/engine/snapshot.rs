@@ -237,18 +237,9 @@ impl EventEngine {
             if stored.partner == NONE || stored.partner_count != self.counter[j] {
                 continue;
             }
-            let me = self.motion[i];
             let found = images.clone().any(|k| {
                 let image = |d: DVec2| self.nearest_image(d) + k;
-                let mut best = NO_PAIR;
-                if self.gravity != DVec2::ZERO {
-                    self.look_falling(i, j, image, &mut best);
-                } else if self.images_wrap {
-                    self.look_at::<true>(&me, j, image, &mut best);
-                } else {
-                    self.look_at::<false>(&me, j, image, &mut best);
-                }
-                best.time == stored.time
+                self.pair_alone(i, j, image).time == stored.time
             });
             if !found {
                 return Err(format!(
@@ -258,6 +249,20 @@ impl EventEngine {
             }
         }
         Ok(())
+    }
+
+    /// The collision of circles `i` and `j` alone, through the image `image` picks, as a
+    /// prediction of `i` would find it with `j` among its neighbours.
+    fn pair_alone(&self, i: usize, j: usize, image: impl Fn(DVec2) -> DVec2) -> BestPair {
+        let mut best = NO_PAIR;
+        if self.gravity != DVec2::ZERO {
+            self.look_falling(i, j, image, &mut best);
+        } else if self.images_wrap {
+            self.look_at::<true>(&self.motion[i], j, image, &mut best);
+        } else {
+            self.look_at::<false>(&self.motion[i], j, image, &mut best);
+        }
+        best
     }
 
     /// Whether no two neighbours meet before both their best pairs. Each best pair is checked
@@ -273,16 +278,8 @@ impl EventEngine {
             if self.large_reach(i).is_some() {
                 continue; // its pairs are looked at from the other side, large ones aside
             }
-            let me = self.motion[i];
             let missed = |j: usize| {
-                let mut best = NO_PAIR;
-                if self.gravity != DVec2::ZERO {
-                    self.look_falling(i, j, nearest, &mut best);
-                } else if self.images_wrap {
-                    self.look_at::<true>(&me, j, nearest, &mut best);
-                } else {
-                    self.look_at::<false>(&me, j, nearest, &mut best);
-                }
+                let best = self.pair_alone(i, j, nearest);
                 best.partner != NONE && best.time < best_time(i).min(best_time(j))
             };
             let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
