@@ -231,8 +231,8 @@ pub(super) struct Own<'a> {
 /// step; updates it if user code moved or steered a few of them (a teleport, a kinematic
 /// paddle); otherwise builds a fresh one from the circles, with their own restitutions and
 /// layers. `swept` keeps its engine only while nothing in it moves and nothing outside touched
-/// a circle, and builds a fresh one otherwise. Says which in a debug log. A build that `stop` ends leaves no
-/// engine: the step then moves nothing and counts in `budget_exhausted`.
+/// a circle, and builds a fresh one otherwise. Says which in a debug log. A build that `stop`
+/// ends leaves no engine: the step then moves nothing and counts in `budget_exhausted`.
 pub(super) fn gather_into_engine(
     (setup, stop): ((Solver, Arena, Effects, &Segments), Option<&StopRequest>),
     state: &mut EngineState,

@@ -235,8 +235,7 @@ fn a_checkpoint_marking_a_circle_asleep_resumes_under_exact_without_gravity_to_a
 }
 
 #[test]
-fn a_heap_checkpointed_while_still_then_kicked_goes_on_as_the_run_does_under_the_event_driven_solvers()
- {
+fn a_heap_checkpointed_while_still_goes_on_as_the_run_does_under_the_event_driven_solvers() {
     // Half a second after the whole heap fell asleep nothing has moved for 30 steps, and
     // `swept` keeps its engine. A checkpoint taken then must lead to the same heap and the same
     // sleepers' timers, left alone and after the same kick to the run and the resumed one.

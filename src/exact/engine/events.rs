@@ -80,8 +80,8 @@ pub(super) const NO_PAIR: BestPair = BestPair {
 };
 
 /// Where a circle stands in coming to rest under gravity, carried from one engine to the next
-/// (`swept` builds one every step something moves): whether it sleeps, and the place it has stayed near while
-/// bouncing its least bounce, for how long.
+/// (`swept` builds one every step something moves): whether it sleeps, and the place it has
+/// stayed near while bouncing its least bounce, for how long.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Rest {
     /// Whether it sleeps.
