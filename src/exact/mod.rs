@@ -196,22 +196,22 @@ fn continuous_step(
         // A stop gave up the build: this step moves, turns and wakes nothing.
         return;
     };
-    if *solver == Solver::Swept && effects.gravity.is_some() && engine.is_still() {
-        // Nothing moves (a pile asleep): no event can come, and the engine, kept or fresh, is
-        // not advanced; the step writes back what a fresh engine advanced by it would.
-        write_back(&mut state, &mut circles.p0());
-        counted.sleeping.count = age_rest(&state, &mut circles.p2(), dt.0);
-    } else {
+    // Nothing moves (a pile asleep): no event can come, and the engine, kept or fresh, is not
+    // advanced; the step writes back what a fresh engine advanced by it would.
+    let still = *solver == Solver::Swept && effects.gravity.is_some() && engine.is_still();
+    if !still {
         advance_engine(
             (*solver, dt.0, *budget, stop.as_deref()),
             &mut state,
             (&mut counted.pairs, &mut counted.walls),
             messages,
         );
-        write_back(&mut state, &mut circles.p0());
-        counted.sleeping.count =
-            write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count);
     }
+    write_back(&mut state, &mut circles.p0());
+    counted.sleeping.count = match still {
+        true => age_rest(&state, &mut circles.p2(), dt.0),
+        false => write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count),
+    };
     if !write_back_turning(&state, &mut circles.p3()) {
         turn_circles(&mut circles.p3(), dt.0); // smooth circles trade no spin
     }

@@ -173,26 +173,27 @@ fn drops_and_sleeps(text: &str, name: &str) -> moving_circles::run::Report {
     report
 }
 
+/// The heap of these tests under `solver`: 60 circles of radii 0.2 to 0.4 dropped into a box
+/// 3 wide, restitution 0.5.
+fn heap(solver: &str) -> String {
+    format!(
+        "(solver: \"{solver}\", arena: (size: (3.0, 8.0)),
+          effects: (gravity: (0.0, -9.81), restitution: 0.5, wall_restitution: 0.5),
+          spawn: (count: 60, radius: (0.2, 0.4), speed: (0.0, 1.0), seed: 6))"
+    )
+}
+
 #[test]
 fn a_heap_falls_settles_and_sleeps_with_no_overlap_under_the_event_driven_solvers() {
     for solver in ["exact", "swept"] {
-        // 60 circles of radii 0.2 to 0.4 dropped into a box 3 wide, restitution 0.5.
-        let heap = format!(
-            "(solver: \"{solver}\", arena: (size: (3.0, 8.0)),
-              effects: (gravity: (0.0, -9.81), restitution: 0.5, wall_restitution: 0.5),
-              spawn: (count: 60, radius: (0.2, 0.4), speed: (0.0, 1.0), seed: 6))"
-        );
-        drops_and_sleeps(&heap, "heap.ron");
+        drops_and_sleeps(&heap(solver), "heap.ron");
     }
 }
 
 #[test]
 fn a_heap_asleep_under_swept_builds_no_engine_until_something_moves() {
     use moving_circles::exact::EngineState;
-    let heap = "(solver: \"swept\", arena: (size: (3.0, 8.0)),
-        effects: (gravity: (0.0, -9.81), restitution: 0.5, wall_restitution: 0.5),
-        spawn: (count: 60, radius: (0.2, 0.4), speed: (0.0, 1.0), seed: 6))";
-    let mut app = written(heap, "heap.ron");
+    let mut app = written(&heap("swept"), "heap.ron");
     step(&mut app, 10 * 60);
     assert!(settled(&mut app).0, "not asleep after 10 s");
     let rebuilds = |app: &App| app.world().resource::<EngineState>().rebuilds;
