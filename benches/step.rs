@@ -270,6 +270,30 @@ fn piles(c: &mut Criterion) {
     group.finish();
 }
 
+/// What a pile that has settled costs while it is awake, where the solve is all the work: the
+/// 2000-circle pile under `soft` with sleeping off, run 12 s, then one step timed. The time a
+/// circle is still awake in a settled pile is what the peers' settled window measures.
+fn pile_awake(c: &mut Criterion) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/pile.ron");
+    let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    scene.effects.sleep.enabled = false;
+    let mut group = c.benchmark_group("step_pile_awake");
+    group.sample_size(20);
+    group.throughput(Throughput::Elements(scene.spawn.count as u64));
+    let mut app = None;
+    group.bench_function(BenchmarkId::new(scene.solver.to_string(), "pile"), |b| {
+        let app = app.get_or_insert_with(|| {
+            let mut app = headless_app(scene.clone());
+            for _ in 0..12 * 60 {
+                app.update();
+            }
+            app
+        });
+        b.iter(|| app.update())
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
     solvers,
@@ -279,6 +303,7 @@ criterion_group!(
     segments,
     eos_point,
     sparse_step,
-    piles
+    piles,
+    pile_awake
 );
 criterion_main!(benches);
