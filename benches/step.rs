@@ -2,8 +2,8 @@
 //! `finish()`, spawning and one warm-up step. Per solver on gases of growing N, and the price of
 //! effects: a no-collision scene against the same scene with collisions and against bare
 //! integration; collision messages off and on; layers and sensors; a gas without and among
-//! 2000 segment walls; a
-//! sparse step, where the step's own work is all there is; and the pile scenes once they rest.
+//! 2000 segment walls; a sparse step, where the step's own work is all there is; the pile
+//! scenes once they rest; and the 2000-circle pile settled but kept awake.
 //!
 //! `cargo bench --bench step`; set `MC_BENCH_LARGE=1` to add N = 100k for every solver and
 //! N = 1M for `discrete`.
@@ -270,9 +270,10 @@ fn piles(c: &mut Criterion) {
     group.finish();
 }
 
-/// What a pile that has settled costs while it is awake, where the solve is all the work: the
-/// 2000-circle pile under `soft` with sleeping off, run 12 s, then one step timed. The time a
-/// circle is still awake in a settled pile is what the peers' settled window measures.
+/// What a settled pile costs while it is awake, where the solve is all the work: the
+/// 2000-circle pile under `soft` with sleeping off, run 12 s, then one step timed. A settled
+/// pile still awake is what the peers' harness times in its settled window (no peer's pile of
+/// 2000 sleeps there).
 fn pile_awake(c: &mut Criterion) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/pile.ron");
     let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
