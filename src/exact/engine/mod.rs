@@ -343,6 +343,16 @@ impl EventEngine {
             .index(self.cell_x[i] as usize, self.cell_y[i] as usize)
     }
 
+    /// The circles listed in the cells around circle `i`'s (its own among them), then the
+    /// large circles, which no cell lists: every circle near enough to touch `i`.
+    fn near(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        let (cells, len) = self
+            .grid
+            .block(self.cell_x[i] as usize, self.cell_y[i] as usize);
+        let listed = (0..len).flat_map(move |k| self.cells.members(cells[k]));
+        listed.chain(self.large.iter().map(|&j| j as usize))
+    }
+
     /// Puts every circle in the cell its position now lies in (large circles in none, but each
     /// still knows its cell). Where every reference time is now (a build, a drift) that is the
     /// reference point itself.

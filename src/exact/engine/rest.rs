@@ -219,10 +219,7 @@ impl EventEngine {
                 normals.push(out);
             }
         }
-        let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
-        let (block, len) = self.grid.block(x, y);
-        let near = block[..len].iter().flat_map(|&c| self.cells.members(c));
-        for j in near.chain(self.large.iter().map(|&j| j as usize)) {
+        for j in self.near(i) {
             let resting =
                 self.asleep[j] || (self.inv_mass[j] == 0.0 && self.velocity(j) == DVec2::ZERO);
             if j == i || !resting || !self.meets(i, j) {

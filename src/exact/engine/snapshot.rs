@@ -282,11 +282,7 @@ impl EventEngine {
                 let best = self.pair_alone(i, j, nearest);
                 best.partner != NONE && best.time < best_time(i).min(best_time(j))
             };
-            let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
-            let (cells, len) = self.grid.block(x, y);
-            let members = cells[..len].iter().flat_map(|&c| self.cells.members(c));
-            let neighbours = members.chain(self.large.iter().map(|&j| j as usize));
-            if let Some(j) = neighbours.filter(|&j| j != i).find(|&j| missed(j)) {
+            if let Some(j) = self.near(i).filter(|&j| j != i).find(|&j| missed(j)) {
                 return Err(format!(
                     "circles {i} and {j} meet sooner than either one's best pair"
                 ));
