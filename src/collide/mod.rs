@@ -3,11 +3,13 @@
 //! arrays, which finds overlapping pairs with the [`broad_phase`] and resolves each with the
 //! [`contact`] kernel, and scatters the result back. On a periodic arena pairs interact across
 //! the seam through the minimum image. Pair collisions are counted here ([`PairCollisions`]),
-//! by whichever solver makes them; [`overlaps`] measures overlap in any state.
+//! by whichever solver makes them; [`overlaps`] measures overlap in any state; [`pair_list`]
+//! keeps the broad phase's pairs from step to step for a solver whose circles move little.
 
 pub mod broad_phase;
 pub mod contact;
 pub mod overlaps;
+pub mod pair_list;
 pub mod pass;
 
 use bevy::ecs::schedule::ScheduleLabel;

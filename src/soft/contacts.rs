@@ -1,14 +1,14 @@
 //! The contacts of one `soft` step: which circles may touch a circle, an arena wall or a
 //! segment wall before the step ends ([`find_contacts`]: the broad phase on each circle's reach
-//! over the step, then a speculative margin), each as a [`Constraint`] along a normal fixed for
-//! the step.
+//! over the step, kept from step to step in a [`PairList`], then a speculative margin), each as
+//! a [`Constraint`] along a normal fixed for the step.
 
 use bevy::math::DVec2;
 
 use super::bodies::{Bodies, Softness};
 use crate::arena::Arena;
-use crate::collide::broad_phase::{CellList, overlapping_pairs};
 use crate::collide::contact::{combine_restitution, contact_normal};
+use crate::collide::pair_list::PairList;
 use crate::collision_layers::{meets_any, pair_meets};
 use crate::config::Combine;
 use crate::exact::toi::pair_time_of_impact;
@@ -202,21 +202,33 @@ pub fn turning_rows<'a>(
     }
 }
 
-/// Reusable buffers of contact finding.
+/// How far past its reach (as a fraction of it) a circle's pairs are kept from step to step:
+/// a settled circle moves so little that the list lasts many steps, and a circle that moves
+/// more makes the list again. Box2D enlarges its boxes by 0.1 m, a fifth of a radius of 0.5 m.
+pub const SKIN: f64 = 0.25;
+
+/// Most a circle may travel in a step, as a fraction of its radius, for the pairs to be kept
+/// from step to step: at this speed a list lasts six steps or more. Faster circles (a gas, a
+/// pour) find their pairs afresh each step, which costs less than a list made again each
+/// step. Which way is taken depends on the speeds now, and both hand over the same pairs in
+/// the same order with one grid in a walled arena, so a run never depends on which was taken
+/// before.
+pub const KEEP_BELOW_TRAVEL: f64 = SKIN / 8.0;
+
+/// What contact finding keeps from step to step: the broad phase's pairs, and buffers.
 #[derive(Default)]
 pub struct ContactScratch {
     /// The circles the broad phase searches, by index.
     searched: Vec<u32>,
     reach: Vec<(DVec2, f64)>,
-    candidates: Vec<(u32, u32)>,
-    cells: CellList,
+    list: PairList,
     near: Vec<u32>,
 }
 
 /// Every contact the circles in `bodies` may make during a step under `rules`: pairs (into
-/// `pairs`) and walls (into `walls`), in an order that depends only on the input. A circle's
-/// reach over the step (its radius, plus how far its speed and gravity can take it, plus the
-/// speculative margin) finds the candidates. A candidate pair becomes a contact when it
+/// `pairs`) and walls (into `walls`), in an order that depends only on the circles now, not
+/// on when `scratch`'s list was made. A circle's reach over the step (its radius, plus how far
+/// its speed and gravity can take it, plus the speculative margin) finds the candidates. A candidate pair becomes a contact when it
 /// overlaps (along the normal now), when its straight relative path meets this step (along
 /// the normal where it touches), or when a push from another contact could close its gap
 /// within the step (along the normal where it comes closest); a wall, when its gap can close
@@ -255,22 +267,21 @@ pub fn find_contacts(
             let reach = scratch.searched.iter().map(|&i| reach_of(i as usize));
             scratch.reach.extend(reach);
         }
-        scratch.candidates.clear();
-        let (reach, candidates) = (&scratch.reach, &mut scratch.candidates);
-        overlapping_pairs(&mut scratch.cells, arena, reach, candidates);
-        let searched = &scratch.searched;
-        for &(k, l) in candidates.iter() {
+        let slow = |i: usize| travel(i) <= KEEP_BELOW_TRAVEL * bodies.radius[i];
+        let keep = (0..bodies.len()).all(slow);
+        let (list, reach, searched) = (&mut scratch.list, &scratch.reach, &scratch.searched);
+        list.for_each_overlapping(arena, reach, (keep, SKIN), |k, l| {
             let (i, j) = match all {
-                true => (k as usize, l as usize),
-                false => (searched[k as usize] as usize, searched[l as usize] as usize),
+                true => (k, l),
+                false => (searched[k] as usize, searched[l] as usize),
             };
             if !pair_meets(layers, i, j) {
-                continue;
+                return;
             }
             if let Some(c) = pair_contact(bodies, arena, rules, (i, j)) {
                 pairs.push(c);
             }
-        }
+        });
     }
     if arena.is_periodic() {
         return;

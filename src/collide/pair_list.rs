@@ -1,0 +1,290 @@
+//! [`PairList`]: the broad phase's pairs kept from step to step (a Verlet list). Made with
+//! every reach grown by a skin, the list holds every pair that can overlap until some circle
+//! has moved, or grown its reach, by most of its skin; until then a step bins the circles (for
+//! their order) but scans no cells. Box2D's enlarged boxes serve the same end. What a step is
+//! handed depends only on the circles now, never on when the list was made: the pairs whose
+//! reaches overlap now, in the order a fresh broad phase finds them, so a solver that takes
+//! them one after another works through neighbours together, and gets the same result.
+
+use bevy::math::DVec2;
+
+use super::broad_phase::{CellList, needs_levels, overlapping_pairs, radius_range};
+use crate::arena::Arena;
+
+/// Part of the skin a circle may use up before the list is made again: the rest is a cushion
+/// that keeps rounding in the distances from ever dropping a pair.
+const USABLE_SKIN: f64 = 0.75;
+
+/// The broad phase's pairs kept from step to step, each under both of its circles.
+#[derive(Default)]
+pub struct PairList {
+    /// Each circle's centre when the list was made, and the reach plus distance moved it may
+    /// have before the list is made again.
+    made: Vec<(DVec2, f64)>,
+    /// `partners[start[i]..start[i + 1]]` are the circles `i` may overlap, ascending.
+    start: Vec<u32>,
+    partners: Vec<u32>,
+    cells: CellList,
+    /// Each circle's place in the cell order `sequence` follows (`u32::MAX` for a circle
+    /// with a non-finite centre, which overlaps nothing).
+    rank: Vec<u32>,
+    later: Vec<u32>,
+    /// The list's pairs, `(i, j)` with `i < j`, in the order they are handed over.
+    sequence: Vec<(u32, u32)>,
+    /// The cell order `sequence` was put in order for.
+    sequenced_for: Vec<u32>,
+    grown: Vec<(DVec2, f64)>,
+    found: Vec<(u32, u32)>,
+    /// How many times the list has been made.
+    made_count: u64,
+}
+
+impl PairList {
+    /// Hands `visit` every pair `(i, j)`, `i < j`, of `circles` (centre, reach) whose reaches
+    /// overlap in `arena` (centre distance below their sum; the minimum image on a periodic
+    /// arena): what [`overlapping_pairs`] finds.
+    ///
+    /// With `keep`, from the list, in the order the broad phase finds them with one grid (radii
+    /// within [`super::broad_phase::MULTI_LEVEL_RATIO`], a periodic arena at least three cells
+    /// across): the cell order now (cells twice the largest reach wide; the smallest, when
+    /// radii need more than one grid), by the place of whichever of the two comes first in it,
+    /// then of the other. The list is made again, each reach grown by `skin` times itself, when
+    /// a circle has moved too far, grown its reach or come or gone since it was last made.
+    ///
+    /// Without `keep` (circles too fast for a list to last), by a fresh broad phase, in its
+    /// order; the list is left as it is.
+    pub fn for_each_overlapping(
+        &mut self,
+        arena: &Arena,
+        circles: &[(DVec2, f64)],
+        (keep, skin): (bool, f64),
+        mut visit: impl FnMut(usize, usize),
+    ) {
+        if !keep {
+            self.found.clear();
+            overlapping_pairs(&mut self.cells, arena, circles, &mut self.found);
+            for &(i, j) in &self.found {
+                visit(i as usize, j as usize);
+            }
+            return;
+        }
+        let made = !self.holds(arena, circles);
+        if made {
+            self.make(arena, circles, skin);
+        }
+        // Cells as the broad phase's with one grid; with radii too wide for one, as wide as
+        // the smallest circles, so that the order still follows where the circles are.
+        let (smallest, widest) = radius_range(circles);
+        let cell = 2.0
+            * if needs_levels((smallest, widest)) {
+                smallest
+            } else {
+                widest
+            };
+        if arena.is_periodic() {
+            let (min, size) = (arena.min, arena.size());
+            self.cells.rebuild_periodic(circles, min, size, cell);
+        } else {
+            self.cells.rebuild(circles, cell);
+        }
+        // The order of the pairs changes only with the list or with the cell order.
+        if made || self.cells.order() != self.sequenced_for {
+            self.sequence_pairs(circles.len());
+        }
+        for &(i, j) in &self.sequence {
+            let ((p, r), (q, s)) = (circles[i as usize], circles[j as usize]);
+            if arena.offset(p, q).length_squared() < (r + s) * (r + s) {
+                visit(i as usize, j as usize);
+            }
+        }
+    }
+
+    /// Puts the list's pairs in the order they are handed over for the cell order now.
+    fn sequence_pairs(&mut self, n: usize) {
+        let order = self.cells.order();
+        self.sequenced_for.clear();
+        self.sequenced_for.extend_from_slice(order);
+        self.rank.clear();
+        self.rank.resize(n, u32::MAX);
+        for (k, &i) in order.iter().enumerate() {
+            self.rank[i as usize] = k as u32;
+        }
+        self.sequence.clear();
+        for (k, &i) in order.iter().enumerate() {
+            // The partners later in the cell order, by their place in it.
+            self.later.clear();
+            let (from, to) = (self.start[i as usize], self.start[i as usize + 1]);
+            let later = self.partners[from as usize..to as usize]
+                .iter()
+                .map(|&j| self.rank[j as usize])
+                .filter(|&place| place > k as u32);
+            self.later.extend(later);
+            self.later.sort_unstable();
+            let pairs = self.later.iter().map(|&place| {
+                let j = order[place as usize];
+                (i.min(j), i.max(j))
+            });
+            self.sequence.extend(pairs);
+        }
+    }
+
+    /// How many times the list has been made since it was created.
+    pub fn made_count(&self) -> u64 {
+        self.made_count
+    }
+
+    /// Whether the list still holds every overlapping pair of `circles`: the same number of
+    /// circles, each within its allowance of where it was (a NaN never is).
+    fn holds(&self, arena: &Arena, circles: &[(DVec2, f64)]) -> bool {
+        self.made.len() == circles.len()
+            && self.made.iter().zip(circles).all(|(&(c, most), &(p, r))| {
+                let room = most - r;
+                room >= 0.0 && arena.offset(c, p).length_squared() <= room * room
+            })
+    }
+
+    /// Makes the list for `circles`, each reach grown by `skin` times itself.
+    fn make(&mut self, arena: &Arena, circles: &[(DVec2, f64)], skin: f64) {
+        self.made_count += 1;
+        self.grown.clear();
+        let grown = circles.iter().map(|&(p, r)| (p, r * (1.0 + skin)));
+        self.grown.extend(grown);
+        self.made.clear();
+        let made = circles
+            .iter()
+            .map(|&(p, r)| (p, r * (1.0 + USABLE_SKIN * skin)));
+        self.made.extend(made);
+        self.found.clear();
+        overlapping_pairs(&mut self.cells, arena, &self.grown, &mut self.found);
+        // A counting sort by circle, each pair under both.
+        self.start.clear();
+        self.start.resize(circles.len() + 1, 0);
+        for &(i, j) in &self.found {
+            self.start[i as usize + 1] += 1;
+            self.start[j as usize + 1] += 1;
+        }
+        for i in 0..circles.len() {
+            self.start[i + 1] += self.start[i];
+        }
+        let mut next = self.start.clone();
+        self.partners.clear();
+        self.partners.resize(2 * self.found.len(), 0);
+        for &(i, j) in &self.found {
+            for (me, other) in [(i, j), (j, i)] {
+                let slot = &mut next[me as usize];
+                self.partners[*slot as usize] = other;
+                *slot += 1;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::*;
+    use crate::arena::Boundary;
+
+    /// What a fresh broad phase finds, sorted.
+    fn fresh(arena: &Arena, circles: &[(DVec2, f64)]) -> Vec<(usize, usize)> {
+        let mut pairs = Vec::new();
+        overlapping_pairs(&mut CellList::default(), arena, circles, &mut pairs);
+        let mut pairs: Vec<_> = pairs
+            .into_iter()
+            .map(|(i, j)| (i as usize, j as usize))
+            .collect();
+        pairs.sort_unstable();
+        pairs
+    }
+
+    #[test]
+    fn a_kept_list_hands_over_what_a_new_one_and_the_broad_phase_do() {
+        for boundary in [Boundary::Walls, Boundary::Periodic] {
+            let arena = Arena {
+                min: DVec2::ZERO,
+                max: DVec2::splat(20.0),
+                boundary,
+            };
+            let mut rng = ChaCha8Rng::seed_from_u64(7);
+            let mut circles: Vec<(DVec2, f64)> = (0..400)
+                .map(|_| {
+                    let p = DVec2::new(rng.random_range(0.0..20.0), rng.random_range(0.0..20.0));
+                    (p, rng.random_range(0.3..0.6))
+                })
+                .collect();
+            let mut list = PairList::default();
+            for step in 0..300 {
+                // Small drifts, a reach that grows now and then, and a jump across the arena
+                // (wrapped on the periodic one) every 50 steps.
+                for (k, (p, r)) in circles.iter_mut().enumerate() {
+                    *p += DVec2::new(rng.random_range(-0.01..0.01), rng.random_range(-0.01..0.01));
+                    *p = arena.wrap(*p);
+                    if (k + step) % 97 == 0 {
+                        *r *= 1.01;
+                    }
+                }
+                if step % 50 == 49 {
+                    circles[step % 400].0 =
+                        arena.wrap(circles[step % 400].0 + DVec2::new(9.7, 3.1));
+                }
+                let mut handed = Vec::new();
+                let kept = (true, 0.25);
+                list.for_each_overlapping(&arena, &circles, kept, |i, j| handed.push((i, j)));
+                // A list made just now hands the same pairs in the same order: what a step is
+                // handed does not depend on when the list was made.
+                let mut new = Vec::new();
+                PairList::default()
+                    .for_each_overlapping(&arena, &circles, kept, |i, j| new.push((i, j)));
+                assert_eq!(handed, new, "{boundary:?}, step {step}");
+                // Without keeping, the broad phase's own order: the same one in a walled box.
+                let mut afresh = Vec::new();
+                let mut other = PairList::default();
+                other.for_each_overlapping(&arena, &circles, (false, 0.25), |i, j| {
+                    afresh.push((i, j))
+                });
+                assert_eq!(other.made_count(), 0);
+                if boundary == Boundary::Walls {
+                    assert_eq!(handed, afresh, "step {step}");
+                }
+                handed.sort_unstable();
+                afresh.sort_unstable();
+                assert_eq!(handed, fresh(&arena, &circles), "{boundary:?}, step {step}");
+                assert_eq!(afresh, handed, "{boundary:?}, step {step}");
+            }
+            let made = list.made_count();
+            assert!((2..150).contains(&made), "{boundary:?}: made {made} times");
+        }
+    }
+
+    #[test]
+    fn the_list_is_made_again_when_circles_come_or_a_centre_is_nan() {
+        let arena = Arena {
+            min: DVec2::ZERO,
+            max: DVec2::splat(10.0),
+            boundary: Boundary::Walls,
+        };
+        let mut circles = vec![(DVec2::new(1.0, 1.0), 0.5), (DVec2::new(1.8, 1.0), 0.5)];
+        let mut list = PairList::default();
+        let mut handed = Vec::new();
+        list.for_each_overlapping(&arena, &circles, (true, 0.25), |i, j| handed.push((i, j)));
+        list.for_each_overlapping(&arena, &circles, (true, 0.25), |i, j| handed.push((i, j)));
+        assert_eq!(
+            (handed.as_slice(), list.made_count()),
+            (&[(0, 1), (0, 1)][..], 1)
+        );
+        circles.push((DVec2::new(2.5, 1.0), 0.5));
+        handed.clear();
+        list.for_each_overlapping(&arena, &circles, (true, 0.25), |i, j| handed.push((i, j)));
+        assert_eq!(
+            (handed.as_slice(), list.made_count()),
+            (&[(0, 1), (1, 2)][..], 2)
+        );
+        circles[2].0.x = f64::NAN;
+        handed.clear();
+        list.for_each_overlapping(&arena, &circles, (true, 0.25), |i, j| handed.push((i, j)));
+        list.for_each_overlapping(&arena, &circles, (true, 0.25), |_, _| {});
+        assert_eq!((handed.as_slice(), list.made_count()), (&[(0, 1)][..], 4));
+    }
+}
