@@ -68,10 +68,7 @@ impl PairList {
             }
             return;
         }
-        let made = !self.holds(arena, circles);
-        if made {
-            self.make(arena, circles, skin);
-        }
+        let made = self.refresh(arena, circles, skin);
         // Cells as the broad phase's with one grid; with radii too wide for one, as wide as
         // the smallest circles, so that the order still follows where the circles are.
         let (smallest, widest) = radius_range(circles);
@@ -97,6 +94,39 @@ impl PairList {
                 visit(i as usize, j as usize);
             }
         }
+    }
+
+    /// Hands `visit` every pair `(i, j)`, `i < j`, of `circles` (centre, reach) whose reaches
+    /// overlap in `arena`, as [`PairList::for_each_overlapping`] with `keep`, in an order for
+    /// callers whose result does not depend on it (by first circle, then as the list keeps
+    /// them), which saves binning the circles.
+    pub fn for_each_overlapping_in_any_order(
+        &mut self,
+        arena: &Arena,
+        circles: &[(DVec2, f64)],
+        skin: f64,
+        mut visit: impl FnMut(usize, usize),
+    ) {
+        self.refresh(arena, circles, skin);
+        for (i, &(p, r)) in circles.iter().enumerate() {
+            let (from, to) = (self.start[i] as usize, self.start[i + 1] as usize);
+            for &j in &self.partners[from..to] {
+                let (q, s) = circles[j as usize];
+                if j as usize > i && arena.offset(p, q).length_squared() < (r + s) * (r + s) {
+                    visit(i, j as usize);
+                }
+            }
+        }
+    }
+
+    /// Makes the list again, each reach grown by `skin` times itself, if it no longer holds
+    /// every overlapping pair of `circles`; returns whether it did.
+    fn refresh(&mut self, arena: &Arena, circles: &[(DVec2, f64)], skin: f64) -> bool {
+        let stale = !self.holds(arena, circles);
+        if stale {
+            self.make(arena, circles, skin);
+        }
+        stale
     }
 
     /// Puts the list's pairs in the order they are handed over for the cell order now.
@@ -200,7 +230,7 @@ mod tests {
     }
 
     #[test]
-    fn a_kept_list_hands_over_what_a_new_one_and_the_broad_phase_do() {
+    fn a_kept_list_hands_over_what_a_new_one_and_the_broad_phase_do_in_their_order() {
         for boundary in [Boundary::Walls, Boundary::Periodic] {
             let arena = Arena {
                 min: DVec2::ZERO,
@@ -214,7 +244,7 @@ mod tests {
                     (p, rng.random_range(0.3..0.6))
                 })
                 .collect();
-            let mut list = PairList::default();
+            let (mut list, mut any_order) = (PairList::default(), PairList::default());
             for step in 0..300 {
                 // Small drifts, a reach that grows now and then, and a jump across the arena
                 // (wrapped on the periodic one) every 50 steps.
@@ -248,10 +278,17 @@ mod tests {
                 if boundary == Boundary::Walls {
                     assert_eq!(handed, afresh, "step {step}");
                 }
+                // In any order: the same pairs, from a list kept alongside.
+                let mut unordered = Vec::new();
+                any_order.for_each_overlapping_in_any_order(&arena, &circles, 0.25, |i, j| {
+                    unordered.push((i, j))
+                });
                 handed.sort_unstable();
                 afresh.sort_unstable();
+                unordered.sort_unstable();
                 assert_eq!(handed, fresh(&arena, &circles), "{boundary:?}, step {step}");
                 assert_eq!(afresh, handed, "{boundary:?}, step {step}");
+                assert_eq!(unordered, handed, "{boundary:?}, step {step}");
             }
             let made = list.made_count();
             assert!((2..150).contains(&made), "{boundary:?}: made {made} times");

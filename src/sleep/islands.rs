@@ -7,11 +7,16 @@ use bevy::math::DVec2;
 
 use crate::arena::Arena;
 use crate::collide::broad_phase::{CellList, overlapping_pairs};
+use crate::collide::pair_list::PairList;
 use crate::collision_layers::{CollisionLayers, pair_meets};
 use crate::components::Sleep;
 
 /// Gap (in the smaller radius) within which two circles count as touching for an island.
 pub const TOUCHING: f64 = 0.05;
+
+/// How far past its reach (as a fraction of it) the touching pairs of all circles are kept
+/// from one look for islands to the next.
+const SKIN: f64 = 0.25;
 
 /// Groups of circles joined by contacts: a union-find over circle indices.
 #[derive(Clone, Debug, Default)]
@@ -73,7 +78,7 @@ impl Resting {
 }
 
 /// Buffers reused from call to call: circle indices, their centres and reaches, the broad
-/// phase's cells and the pairs it found.
+/// phase's cells and the pairs it found, and the touching pairs of all circles.
 #[derive(Default)]
 pub struct IslandScratch {
     /// Each circle's layers (filled by the caller), or empty when every pair meets: circles
@@ -83,9 +88,31 @@ pub struct IslandScratch {
     reach: Vec<(DVec2, f64)>,
     cells: CellList,
     pairs: Vec<(u32, u32)>,
+    /// The touching pairs of all the circles, kept from call to call: circles that may fall
+    /// asleep have barely moved since the last look.
+    all: PairList,
 }
 
 impl IslandScratch {
+    /// The touching pairs that meet among all of `circles`, in no particular order.
+    fn all_touching_pairs(&mut self, circles: &[Resting], arena: &Arena) {
+        self.chosen.clear();
+        self.chosen.extend(0..circles.len() as u32);
+        self.reach.clear();
+        let reach = circles
+            .iter()
+            .map(|c| (c.position, c.radius * (1.0 + TOUCHING)));
+        self.reach.extend(reach);
+        self.pairs.clear();
+        let (pairs, layers) = (&mut self.pairs, &self.layers);
+        self.all
+            .for_each_overlapping_in_any_order(arena, &self.reach, SKIN, |i, j| {
+                if pair_meets(layers, i, j) {
+                    pairs.push((i as u32, j as u32));
+                }
+            });
+    }
+
     /// The touching pairs that meet among the circles `chosen` selects, as positions in
     /// `self.chosen`.
     fn touching_pairs(
@@ -126,7 +153,7 @@ pub fn fall_asleep(
     time: f64,
     scratch: &mut IslandScratch,
 ) -> Vec<usize> {
-    scratch.touching_pairs(circles, arena, |_| true);
+    scratch.all_touching_pairs(circles, arena);
     let mut islands = Islands::new(circles.len());
     let mut pushed = vec![false; circles.len()];
     for &(i, j) in &scratch.pairs {
