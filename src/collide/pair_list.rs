@@ -15,26 +15,29 @@ use crate::arena::Arena;
 /// that keeps rounding in the distances from ever dropping a pair.
 const USABLE_SKIN: f64 = 0.75;
 
-/// The broad phase's pairs kept from step to step, each under both of its circles.
+/// The broad phase's pairs kept from step to step.
 #[derive(Default)]
 pub struct PairList {
     /// Each circle's centre when the list was made, and the reach plus distance moved it may
     /// have before the list is made again.
     made: Vec<(DVec2, f64)>,
-    /// `partners[start[i]..start[i + 1]]` are the circles `i` may overlap, ascending.
-    start: Vec<u32>,
-    partners: Vec<u32>,
+    /// The pairs `(i, j)`, `i < j`, whose grown reaches overlapped when the list was made.
+    pairs: Vec<(u32, u32)>,
     cells: CellList,
     /// Each circle's place in the cell order `sequence` follows (`u32::MAX` for a circle
     /// with a non-finite centre, which overlaps nothing).
     rank: Vec<u32>,
-    later: Vec<u32>,
-    /// The list's pairs, `(i, j)` with `i < j`, in the order they are handed over.
+    /// The list's pairs in the order they are handed over, and the same sorted by their
+    /// later circle's place only (the first pass of the sort).
     sequence: Vec<(u32, u32)>,
+    by_later: Vec<(u32, u32)>,
+    /// How many pairs have each place as their first, then where each place's pairs begin.
+    counts: Vec<u32>,
     /// The cell order `sequence` was put in order for.
     sequenced_for: Vec<u32>,
     grown: Vec<(DVec2, f64)>,
-    found: Vec<(u32, u32)>,
+    /// A fresh broad phase's pairs, when the list is not kept.
+    fresh: Vec<(u32, u32)>,
     /// How many times the list has been made.
     made_count: u64,
 }
@@ -61,9 +64,9 @@ impl PairList {
         mut visit: impl FnMut(usize, usize),
     ) {
         if !keep {
-            self.found.clear();
-            overlapping_pairs(&mut self.cells, arena, circles, &mut self.found);
-            for &(i, j) in &self.found {
+            self.fresh.clear();
+            overlapping_pairs(&mut self.cells, arena, circles, &mut self.fresh);
+            for &(i, j) in &self.fresh {
                 visit(i as usize, j as usize);
             }
             return;
@@ -98,8 +101,8 @@ impl PairList {
 
     /// Hands `visit` every pair `(i, j)`, `i < j`, of `circles` (centre, reach) whose reaches
     /// overlap in `arena`, as [`PairList::for_each_overlapping`] with `keep`, in an order for
-    /// callers whose result does not depend on it (by first circle, then as the list keeps
-    /// them), which saves binning the circles.
+    /// callers whose result does not depend on it (as the list keeps them), which saves
+    /// binning the circles.
     pub fn for_each_overlapping_in_any_order(
         &mut self,
         arena: &Arena,
@@ -108,13 +111,10 @@ impl PairList {
         mut visit: impl FnMut(usize, usize),
     ) {
         self.refresh(arena, circles, skin);
-        for (i, &(p, r)) in circles.iter().enumerate() {
-            let (from, to) = (self.start[i] as usize, self.start[i + 1] as usize);
-            for &j in &self.partners[from..to] {
-                let (q, s) = circles[j as usize];
-                if j as usize > i && arena.offset(p, q).length_squared() < (r + s) * (r + s) {
-                    visit(i, j as usize);
-                }
+        for &(i, j) in &self.pairs {
+            let ((p, r), (q, s)) = (circles[i as usize], circles[j as usize]);
+            if arena.offset(p, q).length_squared() < (r + s) * (r + s) {
+                visit(i as usize, j as usize);
             }
         }
     }
@@ -129,7 +129,9 @@ impl PairList {
         stale
     }
 
-    /// Puts the list's pairs in the order they are handed over for the cell order now.
+    /// Puts the list's pairs in the order they are handed over for the cell order now: by
+    /// the place of the first of the two in it, then of the other (two counting sorts, the
+    /// first by the later place, the second, which keeps that order, by the earlier).
     fn sequence_pairs(&mut self, n: usize) {
         let order = self.cells.order();
         self.sequenced_for.clear();
@@ -139,23 +141,31 @@ impl PairList {
         for (k, &i) in order.iter().enumerate() {
             self.rank[i as usize] = k as u32;
         }
-        self.sequence.clear();
-        for (k, &i) in order.iter().enumerate() {
-            // The partners later in the cell order, by their place in it.
-            self.later.clear();
-            let (from, to) = (self.start[i as usize], self.start[i as usize + 1]);
-            let later = self.partners[from as usize..to as usize]
-                .iter()
-                .map(|&j| self.rank[j as usize])
-                .filter(|&place| place > k as u32);
-            self.later.extend(later);
-            self.later.sort_unstable();
-            let pairs = self.later.iter().map(|&place| {
-                let j = order[place as usize];
-                (i.min(j), i.max(j))
-            });
-            self.sequence.extend(pairs);
-        }
+        let rank = &self.rank;
+        // Both places, first and later; none for a circle without one (a non-finite centre
+        // overlaps nothing).
+        let places = |&(i, j): &(u32, u32)| {
+            let (a, b) = (rank[i as usize], rank[j as usize]);
+            let (first, later) = (a.min(b), a.max(b));
+            (later != u32::MAX).then_some((first, later))
+        };
+        let (places_now, counts) = (order.len(), &mut self.counts);
+        let by_later = |pair: &(u32, u32)| places(pair).map(|(_, later)| later);
+        counting_sort(
+            &self.pairs,
+            by_later,
+            places_now,
+            counts,
+            &mut self.by_later,
+        );
+        let by_first = |pair: &(u32, u32)| places(pair).map(|(first, _)| first);
+        counting_sort(
+            &self.by_later,
+            by_first,
+            places_now,
+            counts,
+            &mut self.sequence,
+        );
     }
 
     /// How many times the list has been made since it was created.
@@ -184,27 +194,35 @@ impl PairList {
             .iter()
             .map(|&(p, r)| (p, r * (1.0 + USABLE_SKIN * skin)));
         self.made.extend(made);
-        self.found.clear();
-        overlapping_pairs(&mut self.cells, arena, &self.grown, &mut self.found);
-        // A counting sort by circle, each pair under both.
-        self.start.clear();
-        self.start.resize(circles.len() + 1, 0);
-        for &(i, j) in &self.found {
-            self.start[i as usize + 1] += 1;
-            self.start[j as usize + 1] += 1;
-        }
-        for i in 0..circles.len() {
-            self.start[i + 1] += self.start[i];
-        }
-        let mut next = self.start.clone();
-        self.partners.clear();
-        self.partners.resize(2 * self.found.len(), 0);
-        for &(i, j) in &self.found {
-            for (me, other) in [(i, j), (j, i)] {
-                let slot = &mut next[me as usize];
-                self.partners[*slot as usize] = other;
-                *slot += 1;
-            }
+        self.pairs.clear();
+        overlapping_pairs(&mut self.cells, arena, &self.grown, &mut self.pairs);
+    }
+}
+
+/// `pairs` sorted by `key` (below `keys`) into `out`, pairs of equal keys in their order
+/// there, pairs without a key left out; `counts` is scratch.
+fn counting_sort(
+    pairs: &[(u32, u32)],
+    key: impl Fn(&(u32, u32)) -> Option<u32>,
+    keys: usize,
+    counts: &mut Vec<u32>,
+    out: &mut Vec<(u32, u32)>,
+) {
+    counts.clear();
+    counts.resize(keys + 1, 0);
+    for k in pairs.iter().filter_map(&key) {
+        counts[k as usize + 1] += 1;
+    }
+    for k in 0..keys {
+        counts[k + 1] += counts[k];
+    }
+    out.clear();
+    out.resize(counts[keys] as usize, (0, 0));
+    for pair in pairs {
+        if let Some(k) = key(pair) {
+            let slot = &mut counts[k as usize];
+            out[*slot as usize] = *pair;
+            *slot += 1;
         }
     }
 }
