@@ -7,16 +7,12 @@ use bevy::math::DVec2;
 
 use crate::arena::Arena;
 use crate::collide::broad_phase::{CellList, overlapping_pairs};
-use crate::collide::pair_list::PairList;
+use crate::collide::pair_list::{PairList, SKIN};
 use crate::collision_layers::{CollisionLayers, pair_meets};
 use crate::components::Sleep;
 
 /// Gap (in the smaller radius) within which two circles count as touching for an island.
 pub const TOUCHING: f64 = 0.05;
-
-/// How far past its reach (as a fraction of it) the touching pairs of all circles are kept
-/// from one look for islands to the next.
-const SKIN: f64 = 0.25;
 
 /// Groups of circles joined by contacts: a union-find over circle indices.
 #[derive(Clone, Debug, Default)]

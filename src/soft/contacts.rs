@@ -8,7 +8,7 @@ use bevy::math::DVec2;
 use super::bodies::{Bodies, Softness};
 use crate::arena::Arena;
 use crate::collide::contact::{combine_restitution, contact_normal};
-use crate::collide::pair_list::PairList;
+use crate::collide::pair_list::{PairList, SKIN};
 use crate::collision_layers::{meets_any, pair_meets};
 use crate::config::Combine;
 use crate::exact::toi::pair_time_of_impact;
@@ -202,17 +202,12 @@ pub fn turning_rows<'a>(
     }
 }
 
-/// How far past its reach (as a fraction of it) a circle's pairs are kept from step to step:
-/// a settled circle moves so little that the list lasts many steps, and a circle that moves
-/// more makes the list again. Box2D enlarges its boxes by 0.1 m, a fifth of a radius of 0.5 m.
-pub const SKIN: f64 = 0.25;
-
 /// Most a circle may travel in a step, as a fraction of its radius, for the pairs to be kept
-/// from step to step: at this speed a list lasts six steps or more. Faster circles (a gas, a
-/// pour) find their pairs afresh each step, which costs less than a list made again each
-/// step. Which way is taken depends on the speeds now, and both hand over the same pairs in
-/// the same order with one grid in a walled arena, so a run never depends on which was taken
-/// before.
+/// from step to step ([`PairList`], grown by [`SKIN`]): at this speed a list lasts six steps or
+/// more. Faster circles (a gas, a pour) find their pairs afresh each step, which costs less
+/// than a list made again each step. Which way a step takes depends only on the speeds now, so
+/// a run never depends on what an earlier step did (and with one grid in a walled arena both
+/// ways hand over the same pairs in the same order).
 pub const KEEP_BELOW_TRAVEL: f64 = SKIN / 8.0;
 
 /// What contact finding keeps from step to step: the broad phase's pairs, and buffers.
@@ -228,11 +223,11 @@ pub struct ContactScratch {
 /// Every contact the circles in `bodies` may make during a step under `rules`: pairs (into
 /// `pairs`) and walls (into `walls`), in an order that depends only on the circles now, not
 /// on when `scratch`'s list was made. A circle's reach over the step (its radius, plus how far
-/// its speed and gravity can take it, plus the speculative margin) finds the candidates. A candidate pair becomes a contact when it
-/// overlaps (along the normal now), when its straight relative path meets this step (along
-/// the normal where it touches), or when a push from another contact could close its gap
-/// within the step (along the normal where it comes closest); a wall, when its gap can close
-/// within the step.
+/// its speed and gravity can take it, plus the speculative margin) finds the candidates. A
+/// candidate pair becomes a contact when it overlaps (along the normal now), when its straight
+/// relative path meets this step (along the normal where it touches), or when a push from
+/// another contact could close its gap within the step (along the normal where it comes
+/// closest); a wall, when its gap can close within the step.
 pub fn find_contacts(
     bodies: &Bodies,
     arena: &Arena,
