@@ -97,12 +97,7 @@ impl PairList {
         if made || self.cells.order() != self.sequenced_for {
             self.sequence_pairs(circles.len());
         }
-        for &(i, j) in &self.sequence {
-            let ((p, r), (q, s)) = (circles[i as usize], circles[j as usize]);
-            if arena.offset(p, q).length_squared() < (r + s) * (r + s) {
-                visit(i as usize, j as usize);
-            }
-        }
+        visit_overlapping(arena, circles, &self.sequence, visit);
     }
 
     /// Hands `visit` every pair `(i, j)`, `i < j`, of `circles` (centre, reach) whose reaches
@@ -114,15 +109,10 @@ impl PairList {
         arena: &Arena,
         circles: &[(DVec2, f64)],
         skin: f64,
-        mut visit: impl FnMut(usize, usize),
+        visit: impl FnMut(usize, usize),
     ) {
         self.refresh(arena, circles, skin);
-        for &(i, j) in &self.pairs {
-            let ((p, r), (q, s)) = (circles[i as usize], circles[j as usize]);
-            if arena.offset(p, q).length_squared() < (r + s) * (r + s) {
-                visit(i as usize, j as usize);
-            }
-        }
+        visit_overlapping(arena, circles, &self.pairs, visit);
     }
 
     /// Makes the list again, each reach grown by `skin` times itself, if it no longer holds
@@ -202,6 +192,22 @@ impl PairList {
         self.made.extend(made);
         self.pairs.clear();
         overlapping_pairs(&mut self.cells, arena, &self.grown, &mut self.pairs);
+    }
+}
+
+/// Hands `visit` each of `pairs`, in their order, whose circles' reaches overlap in `arena`.
+#[inline]
+fn visit_overlapping(
+    arena: &Arena,
+    circles: &[(DVec2, f64)],
+    pairs: &[(u32, u32)],
+    mut visit: impl FnMut(usize, usize),
+) {
+    for &(i, j) in pairs {
+        let ((p, r), (q, s)) = (circles[i as usize], circles[j as usize]);
+        if arena.offset(p, q).length_squared() < (r + s) * (r + s) {
+            visit(i as usize, j as usize);
+        }
     }
 }
 

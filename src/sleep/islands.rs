@@ -66,6 +66,11 @@ pub struct Resting {
 }
 
 impl Resting {
+    /// Its centre, and the reach within which it touches another circle.
+    fn touching_reach(&self) -> (DVec2, f64) {
+        (self.position, self.radius * (1.0 + TOUCHING))
+    }
+
     /// Whether it is awake and not at rest for `time` (a movable circle), or pushing (a
     /// kinematic one): what wakes the sleeping circles it touches.
     fn stirring(&self, time: f64) -> bool {
@@ -92,13 +97,9 @@ pub struct IslandScratch {
 impl IslandScratch {
     /// The touching pairs that meet among all of `circles`, in no particular order.
     fn all_touching_pairs(&mut self, circles: &[Resting], arena: &Arena) {
-        self.chosen.clear();
-        self.chosen.extend(0..circles.len() as u32);
         self.reach.clear();
-        let reach = circles
-            .iter()
-            .map(|c| (c.position, c.radius * (1.0 + TOUCHING)));
-        self.reach.extend(reach);
+        self.reach
+            .extend(circles.iter().map(Resting::touching_reach));
         self.pairs.clear();
         let (pairs, layers) = (&mut self.pairs, &self.layers);
         self.all
@@ -121,10 +122,11 @@ impl IslandScratch {
         self.chosen
             .extend((0..circles.len() as u32).filter(|&i| chosen(&circles[i as usize])));
         self.reach.clear();
-        self.reach.extend(self.chosen.iter().map(|&i| {
-            let c = &circles[i as usize];
-            (c.position, c.radius * (1.0 + TOUCHING))
-        }));
+        let reach = self
+            .chosen
+            .iter()
+            .map(|&i| circles[i as usize].touching_reach());
+        self.reach.extend(reach);
         self.pairs.clear();
         overlapping_pairs(&mut self.cells, arena, &self.reach, &mut self.pairs);
         if !self.layers.is_empty() {
