@@ -13,8 +13,10 @@
 
 pub mod bodies;
 pub mod cache;
+pub mod colours;
 pub mod contacts;
 pub mod friction;
+pub mod sequential;
 pub mod solve;
 pub mod stats;
 

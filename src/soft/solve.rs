@@ -6,23 +6,25 @@
 //! leaves no velocity behind); once after the substeps, the restitution pass; last, store the
 //! impulses for the next step.
 //!
-//! Contacts are solved one after another in a fixed order (Gauss-Seidel; arena and segment
-//! walls first, then pairs in the broad phase's order), so a step is the same on any number of
-//! threads.
+//! Contacts are solved in a fixed order (Gauss-Seidel): arena and segment walls first, one
+//! after another ([`super::sequential`]); then the pairs, in a step without friction colour by
+//! colour, four at a time ([`super::colours`]), in a step with friction one after another in
+//! the broad phase's order. So a step is the same on any number of threads.
 
 use bevy::math::DVec2;
 
 use super::bodies::{Bodies, Softness};
 use super::cache::ContactCache;
+use super::colours::{Colours, Pass, passes};
 use super::contacts::{
     Constraint, ContactRules, ContactScratch, TurningRow, find_contacts, may_turn, turning_rows,
 };
-use super::friction::{solve_turning, turn, warm_start_turning};
-use super::stats::{SoftStats, count};
+use super::friction::turn;
+use super::sequential::{restitution, solve, solve_one, warm_start, warm_start_one};
+use super::stats::{SoftStats, Work, count};
 use crate::arena::Arena;
 use crate::boundary::put_back_inside;
 use crate::config::{Combine, SoftConfig};
-use crate::grid::NONE;
 use crate::hits::HitLog;
 use crate::segment::{Segment, SegmentCells};
 
@@ -58,6 +60,7 @@ pub struct SoftScratch {
     pairs: Vec<Constraint>,
     walls: Vec<Constraint>,
     rows: Vec<TurningRow>,
+    colours: Colours,
 }
 
 /// Advances `bodies` by one step of `params.dt` in `arena` among `segments` (with the cells
@@ -169,6 +172,7 @@ fn soft_part(
         pairs,
         walls,
         rows,
+        colours,
     } = scratch;
     find_contacts(bodies, arena, segments, &rules, contacts, (pairs, walls));
     rows.clear();
@@ -186,14 +190,19 @@ fn soft_part(
     let mut work = Work::default();
     let rows_empty = rows.is_empty();
     let (dv, drag) = (params.gravity * h, (-params.drag * h).exp());
-    for _ in 0..substeps {
-        integrate_velocities(bodies, dv, drag);
-        // A step without friction runs its passes without looking for turning rows at all.
-        let contacts = (&mut walls[..], &mut pairs[..], &mut rows[..]);
-        if rows_empty {
-            substep::<false>(bodies, contacts, h, &mut work);
-        } else {
-            substep::<true>(bodies, contacts, h, &mut work);
+    if rows_empty {
+        // A step without friction solves its pairs colour by colour, four at a time.
+        colours.pack(bodies.len(), pairs);
+        for _ in 0..substeps {
+            integrate_velocities(bodies, dv, drag);
+            coloured_substep(bodies, (walls, pairs, colours), h, &mut work);
+        }
+        colours.unpack(pairs);
+    } else {
+        for _ in 0..substeps {
+            integrate_velocities(bodies, dv, drag);
+            let contacts = (&mut walls[..], &mut pairs[..], &mut rows[..]);
+            turning_substep(bodies, contacts, h, &mut work);
         }
     }
     restitution(bodies, (walls, pairs), &mut work);
@@ -209,34 +218,66 @@ fn soft_part(
     stats
 }
 
-/// One substep: warm start, solve with the soft push-out, move and turn, relax (the turning
-/// rows' part of each pass only with `TURNING`).
-fn substep<const TURNING: bool>(
+/// One substep of a step without friction: warm start, solve with the soft push-out, move,
+/// relax; in each pass the walls one after another, then the pairs colour by colour (the
+/// groups, then the pairs no colour was free for).
+fn coloured_substep(
+    bodies: &mut Bodies,
+    (walls, pairs, colours): (&mut [Constraint], &mut [Constraint], &mut Colours),
+    h: f64,
+    work: &mut Work,
+) {
+    let inv_h = 1.0 / h;
+    for c in walls.iter_mut() {
+        warm_start_one::<false, true>(bodies, c, &[], work);
+    }
+    colour_pass(bodies, (pairs, colours), Pass::WarmStart, work);
+    for bias in [true, false] {
+        if !bias {
+            integrate_positions(bodies, h);
+        }
+        for c in walls.iter_mut() {
+            solve_one::<false, true>(bodies, (c, &mut []), inv_h, bias, work);
+        }
+        colour_pass(bodies, (pairs, colours), Pass::Solve { inv_h, bias }, work);
+    }
+}
+
+/// One pass over the groups of `colours`, then over the pairs that found no colour.
+fn colour_pass(
+    bodies: &mut Bodies,
+    (pairs, colours): (&mut [Constraint], &mut Colours),
+    pass: Pass,
+    work: &mut Work,
+) {
+    let Bodies {
+        position, velocity, ..
+    } = bodies;
+    passes(&mut colours.groups, position, velocity, pass, work);
+    for &k in &colours.rest {
+        let c = &mut pairs[k as usize];
+        match pass {
+            Pass::WarmStart => warm_start_one::<false, false>(bodies, c, &[], work),
+            Pass::Solve { inv_h, bias } => {
+                solve_one::<false, false>(bodies, (c, &mut []), inv_h, bias, work)
+            }
+        }
+    }
+}
+
+/// One substep of a step with friction: warm start, solve with the soft push-out, move and
+/// turn, relax, every contact with its turning row, one after another.
+fn turning_substep(
     bodies: &mut Bodies,
     (walls, pairs, rows): (&mut [Constraint], &mut [Constraint], &mut [TurningRow]),
     h: f64,
     work: &mut Work,
 ) {
-    warm_start::<TURNING>(bodies, (walls, pairs), rows, work);
-    solve::<TURNING>(bodies, (walls, pairs, rows), 1.0 / h, true, work);
+    warm_start::<true>(bodies, (walls, pairs), rows, work);
+    solve::<true>(bodies, (walls, pairs, rows), 1.0 / h, true, work);
     integrate_positions(bodies, h);
     turn(bodies, h);
-    solve::<TURNING>(bodies, (walls, pairs, rows), 1.0 / h, false, work);
-}
-
-/// The work immovable circles did on movable ones through their contacts' impulses, and the
-/// momentum they gave them.
-#[derive(Default)]
-struct Work {
-    energy: f64,
-    momentum: DVec2,
-}
-
-impl Work {
-    fn add(&mut self, (energy, momentum): (f64, DVec2)) {
-        self.energy += energy;
-        self.momentum += momentum;
-    }
+    solve::<true>(bodies, (walls, pairs, rows), 1.0 / h, false, work);
 }
 
 /// Gravity and drag for every movable circle, over one substep.
@@ -253,148 +294,6 @@ fn integrate_positions(bodies: &mut Bodies, h: f64) {
     for (p, &v) in bodies.position.iter_mut().zip(&bodies.velocity) {
         *p += v * h;
     }
-}
-
-/// Applies impulse `j` along contact `c`'s normal (to `a` against it, to `b` along it); `WALL`
-/// says whether `c` is a wall's (which has no `b`), so each kind of contact gets its own loop.
-#[inline(always)]
-fn apply<const WALL: bool>(bodies: &mut Bodies, c: &Constraint, j: f64, work: &mut Work) {
-    let (wa, wb) = c.inv_mass;
-    let p = c.normal * j;
-    let a = c.a as usize;
-    if WALL {
-        bodies.velocity[a] -= p * wa;
-        return;
-    }
-    let b = c.b as usize;
-    if wa == 0.0 || wb == 0.0 {
-        // One side is immovable: the work it did is its push times its own velocity along the
-        // push (none for a static peg), and the momentum it gave is the push.
-        let (pusher, push) = if wa == 0.0 { (a, p) } else { (b, -p) };
-        work.energy += push.dot(bodies.velocity[pusher]);
-        work.momentum += push;
-    }
-    bodies.velocity[a] -= p * wa;
-    bodies.velocity[b] += p * wb;
-}
-
-/// Applies each contact's impulse from the last substep (or step) again: the solve then only
-/// corrects it.
-fn warm_start<const TURNING: bool>(
-    bodies: &mut Bodies,
-    (walls, pairs): (&mut [Constraint], &mut [Constraint]),
-    rows: &[TurningRow],
-    work: &mut Work,
-) {
-    fn each<const TURNING: bool, const WALL: bool>(
-        bodies: &mut Bodies,
-        contacts: &mut [Constraint],
-        rows: &[TurningRow],
-        work: &mut Work,
-    ) {
-        for c in contacts {
-            if c.impulse > 0.0 {
-                apply::<WALL>(bodies, c, c.impulse, work);
-                c.total_impulse += c.impulse;
-            }
-            if TURNING && c.turn != NONE {
-                work.add(warm_start_turning(bodies, c, &rows[c.turn as usize]));
-            }
-        }
-    }
-    each::<TURNING, true>(bodies, walls, rows, work);
-    each::<TURNING, false>(bodies, pairs, rows, work);
-}
-
-/// The other side's position and velocity for contact `c` (a wall's if `WALL`): a wall's
-/// anchor at rest, or `b`'s image.
-#[inline(always)]
-fn other_side<const WALL: bool>(bodies: &Bodies, c: &Constraint) -> (DVec2, DVec2) {
-    if WALL {
-        (c.anchor, DVec2::ZERO)
-    } else {
-        let b = c.b as usize;
-        (bodies.position[b] + c.anchor, bodies.velocity[b])
-    }
-}
-
-/// One pass over the contacts, walls first. With `use_bias` an overlap is pushed out softly
-/// (at most at the contact's push speed); without it (the relax pass) only approach is
-/// stopped. Either way a gap still open lets the pair approach by as much as closes it within
-/// the substep: the speculative part that keeps fast circles from tunnelling.
-fn solve<const TURNING: bool>(
-    bodies: &mut Bodies,
-    (walls, pairs, rows): (&mut [Constraint], &mut [Constraint], &mut [TurningRow]),
-    inv_h: f64,
-    use_bias: bool,
-    work: &mut Work,
-) {
-    fn each<const TURNING: bool, const WALL: bool>(
-        bodies: &mut Bodies,
-        (contacts, rows): (&mut [Constraint], &mut [TurningRow]),
-        inv_h: f64,
-        use_bias: bool,
-        work: &mut Work,
-    ) {
-        for c in contacts {
-            let a = c.a as usize;
-            let (pb, vb) = other_side::<WALL>(bodies, c);
-            let s = c.separation(bodies.position[a], pb);
-            let (bias, soft) = if s > 0.0 {
-                (s * inv_h, Softness::RIGID)
-            } else if use_bias {
-                ((c.soft.bias_rate * s).max(-c.push), c.soft)
-            } else {
-                (0.0, Softness::RIGID)
-            };
-            let vn = (vb - bodies.velocity[a]).dot(c.normal);
-            c.approach = c.approach.max(-vn);
-            let j = -c.normal_mass * soft.mass_scale * (vn + bias) - soft.impulse_scale * c.impulse;
-            let total = (c.impulse + j).max(0.0);
-            let j = total - c.impulse;
-            c.impulse = total;
-            c.total_impulse += j;
-            apply::<WALL>(bodies, c, j, work);
-            if TURNING && c.turn != NONE {
-                work.add(solve_turning(bodies, c, &mut rows[c.turn as usize]));
-            }
-        }
-    }
-    each::<TURNING, true>(bodies, (walls, rows), inv_h, use_bias, work);
-    each::<TURNING, false>(bodies, (pairs, rows), inv_h, use_bias, work);
-}
-
-/// Bounces the contacts that began to push this step (a hit, not a contact that rests from
-/// step to step, as rapier does) faster than their threshold: the normal velocity after the
-/// step is set to `-e` times the one before it, never pulling. A speculative contact that never
-/// closed has nothing to bounce. Bouncing only new contacts is what keeps a packing of
-/// touching circles from gaining energy: restitution applied to every contact of a circle,
-/// one after another, each aiming at its own approach speed from before the step, pushes the
-/// circle harder than any one hit would.
-fn restitution(
-    bodies: &mut Bodies,
-    (walls, pairs): (&mut [Constraint], &mut [Constraint]),
-    work: &mut Work,
-) {
-    fn each<const WALL: bool>(bodies: &mut Bodies, contacts: &mut [Constraint], work: &mut Work) {
-        for c in contacts {
-            let resting = c.was_touching || c.total_impulse == 0.0;
-            if resting || c.restitution == 0.0 || c.relative_velocity > -c.threshold {
-                continue;
-            }
-            let a = c.a as usize;
-            let (_, vb) = other_side::<WALL>(bodies, c);
-            let vn = (vb - bodies.velocity[a]).dot(c.normal);
-            let j = -c.normal_mass * (vn + c.restitution * c.relative_velocity);
-            let total = (c.impulse + j).max(0.0);
-            let j = total - c.impulse;
-            c.impulse = total;
-            c.total_impulse += j;
-            apply::<WALL>(bodies, c, j, work);
-        }
-    }
-    each::<true>(bodies, walls, work);
-    each::<false>(bodies, pairs, work);
 }
 
 /// Puts back a centre that a push or a fast step left outside the arena (walls), or wraps it

@@ -8,6 +8,24 @@ use super::bodies::Bodies;
 use super::contacts::{Constraint, Partner};
 use crate::hits::{CircleHit, HitLog, WallHit};
 
+/// The work immovable circles did on movable ones through their contacts' impulses, and the
+/// momentum they gave them, added up over a step's passes.
+#[derive(Default)]
+pub struct Work {
+    /// Work (N·m).
+    pub energy: f64,
+    /// Momentum.
+    pub momentum: DVec2,
+}
+
+impl Work {
+    /// Adds one contact's work and momentum.
+    pub fn add(&mut self, (energy, momentum): (f64, DVec2)) {
+        self.energy += energy;
+        self.momentum += momentum;
+    }
+}
+
 /// What one `soft` step did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SoftStats {

@@ -1,6 +1,6 @@
 //! Layers under every solver, against brute force: no solver resolves, predicts or reports a
-//! hit between circles whose layers do not meet; teams that do not meet move exactly as they
-//! would alone; layers changed by game code take effect at the next step, also in a kept
+//! hit between circles whose layers do not meet; under the event-driven solvers teams that do
+//! not meet move exactly as they would alone; layers changed by game code take effect at the next step, also in a kept
 //! `exact` engine. (Sensors and the spatial queries' filters are in `sensors.rs`.)
 
 use crate::common::*;
@@ -87,12 +87,21 @@ pub(crate) fn states(app: &App, entities: &[Entity]) -> Vec<(DVec2, DVec2)> {
     entities.iter().map(|&e| state(app, e)).collect()
 }
 
+/// Under the event-driven solvers, two teams that do not meet move bit for bit as each would
+/// alone: every event is one pair's or one circle's, worked out from their own motions. The
+/// time-stepped solvers take their contacts in the order of the cells of the whole world, so a
+/// second team changes that order and with it the last bits, though never what meets what
+/// (the other tests here); over 300 steps and seeds 7 to 12 that showed under `discrete` (seed
+/// 8) and `soft` (seeds 9 and 10) before contacts were solved by colours.
 #[test]
 fn teams_that_do_not_meet_move_exactly_as_they_would_alone() {
     let red = CollisionLayers::new(0b01, 0b01);
     let blue = CollisionLayers::new(0b10, 0b10);
-    for solver in EVERY_SOLVER {
-        let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for (solver, seed) in [Solver::Swept, Solver::Exact]
+        .into_iter()
+        .flat_map(|solver| (7..=12).map(move |seed| (solver, seed)))
+    {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let reds = grid_bodies(&mut rng, 40, DVec2::ZERO, |_, _| (Some(red), false));
         let blues = grid_bodies(&mut rng, 40, DVec2::new(0.45, 0.3), |_, _| {
             (Some(blue), false)
@@ -110,21 +119,21 @@ fn teams_that_do_not_meet_move_exactly_as_they_would_alone() {
         let mut alone_blue = empty_box(solver);
         let alone_blue_ids = spawn_bodies(&mut alone_blue, &blues);
         for app in [&mut both, &mut alone_red, &mut alone_blue] {
-            step(app, 120);
+            step(app, 300);
         }
         let together = pair_collisions(&both);
         let apart = pair_collisions(&alone_red) + pair_collisions(&alone_blue);
         assert!(apart > 50, "{solver}: too few collisions to test ({apart})");
-        assert_eq!(together, apart, "{solver}: pair collisions");
+        assert_eq!(together, apart, "{solver}, seed {seed}: pair collisions");
         assert_eq!(
             states(&both, &red_ids),
             states(&alone_red, &alone_red_ids),
-            "{solver}: red"
+            "{solver}, seed {seed}: red"
         );
         assert_eq!(
             states(&both, &blue_ids),
             states(&alone_blue, &alone_blue_ids),
-            "{solver}: blue"
+            "{solver}, seed {seed}: blue"
         );
     }
 }
