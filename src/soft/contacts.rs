@@ -222,6 +222,7 @@ pub const KEEP_BELOW_TRAVEL: f64 = SKIN / 8.0;
 pub struct ContactScratch {
     /// The circles the broad phase searches, by index.
     searched: Vec<u32>,
+    travel: Vec<f64>,
     reach: Vec<(DVec2, f64)>,
     list: PairList,
     near: Vec<u32>,
@@ -247,7 +248,12 @@ pub fn find_contacts(
     walls.clear();
     let dt = rules.dt;
     let fall = rules.gravity.length() * dt * dt;
-    let travel = |i: usize| bodies.velocity[i].length() * dt + fall;
+    // How far each circle can get this step, worked out once for the reaches, the choice of
+    // list and the walls.
+    scratch.travel.clear();
+    let each = bodies.velocity.iter().map(|v| v.length() * dt + fall);
+    scratch.travel.extend(each);
+    let travel = &scratch.travel;
     if rules.collisions {
         // With layers, circles that meet nothing (sensors) stay out of the search, so they
         // change neither its cells nor the order of the contacts; `searched` lists the others.
@@ -256,7 +262,7 @@ pub fn find_contacts(
             let r = bodies.radius[i];
             (
                 bodies.position[i],
-                r * (1.0 + SPECULATIVE_MARGIN) + travel(i),
+                r * (1.0 + SPECULATIVE_MARGIN) + travel[i],
             )
         };
         scratch.searched.clear();
@@ -269,8 +275,8 @@ pub fn find_contacts(
             let reach = scratch.searched.iter().map(|&i| reach_of(i as usize));
             scratch.reach.extend(reach);
         }
-        let slow = |i: usize| travel(i) <= KEEP_BELOW_TRAVEL * bodies.radius[i];
-        let keep = (0..bodies.len()).all(slow);
+        let slow = |(t, r): (&f64, &f64)| *t <= KEEP_BELOW_TRAVEL * r;
+        let keep = travel.iter().zip(&bodies.radius).all(slow);
         let (list, reach, searched) = (&mut scratch.list, &scratch.reach, &scratch.searched);
         list.for_each_overlapping(arena, reach, (keep, SKIN), |k, l| {
             let (i, j) = match all {
@@ -295,7 +301,7 @@ pub fn find_contacts(
             continue; // immovable circles are kept inside by whoever steers them
         }
         let (p, r) = (bodies.position[i], bodies.radius[i]);
-        let limit = r * SPECULATIVE_MARGIN + travel(i);
+        let limit = r * SPECULATIVE_MARGIN + travel[i];
         for axis in axes.clone() {
             for high in [false, true] {
                 let wall = ArenaWall::on_axis(axis, high);
