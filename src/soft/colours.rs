@@ -53,58 +53,60 @@ pub struct Group {
     immovable: [bool; LANES],
 }
 
-/// The step's pairs in colour order: full groups, then what found no colour.
+/// The step's pairs in colour order: each colour's groups, then what found no colour.
 #[derive(Default)]
 pub struct Colours {
-    /// Groups of four, colour after colour.
-    pub groups: Vec<Group>,
+    /// Each colour's groups of four (more than this step's, kept for the next).
+    groups: Vec<Vec<Group>>,
+    /// How many pairs each colour has this step.
+    counts: Vec<u32>,
     /// Pairs that found no colour free, by index, in their order.
     pub rest: Vec<u32>,
     masks: Vec<u64>,
-    colour: Vec<u32>,
-    start: Vec<u32>,
 }
 
 impl Colours {
     /// Colours `pairs` between `circles` circles greedily in their order (a contact takes the
-    /// first colour neither of its movable circles has yet) and packs them into groups.
+    /// first colour neither of its movable circles has yet) and packs them into groups, in one
+    /// pass over the pairs.
     pub fn pack(&mut self, circles: usize, pairs: &[Constraint]) {
         self.masks.clear();
         self.masks.resize(circles, 0);
-        self.colour.clear();
         self.rest.clear();
-        let mut counts = [0u32; MAX_COLOURS as usize];
-        self.colour.resize(pairs.len(), 0);
+        self.groups.resize_with(MAX_COLOURS as usize, Vec::new);
+        self.counts.clear();
+        self.counts.resize(MAX_COLOURS as usize, 0);
         for (k, c) in pairs.iter().enumerate() {
             let (a, b) = (c.a as usize, c.b as usize);
             let (wa, wb) = c.inv_mass;
             let mine = |w: f64, i: usize| if w > 0.0 { self.masks[i] } else { 0 };
             let colour = (!(mine(wa, a) | mine(wb, b))).trailing_zeros();
-            self.colour[k] = colour;
             if colour >= MAX_COLOURS {
                 self.rest.push(k as u32);
                 continue;
             }
-            counts[colour as usize] += 1;
             for (w, i) in [(wa, a), (wb, b)] {
                 if w > 0.0 {
                     self.masks[i] |= 1 << colour;
                 }
             }
+            // Groups are filled over last step's: only the lanes past a colour's end are
+            // emptied, below.
+            let (groups, count) = (
+                &mut self.groups[colour as usize],
+                &mut self.counts[colour as usize],
+            );
+            let (group, lane) = (*count as usize / LANES, *count as usize % LANES);
+            if group == groups.len() {
+                groups.push(Group::default());
+            }
+            fill(&mut groups[group], lane, k, c);
+            *count += 1;
         }
-        // Each colour's contacts in their order, four to a group.
-        self.start.clear();
-        let mut groups = 0;
-        for &n in &counts {
-            self.start.push(groups);
-            groups += n.div_ceil(LANES as u32);
-        }
-        // Groups are filled over last step's; only the lanes past a colour's end are emptied.
-        self.groups.resize(groups as usize, Group::default());
-        for (colour, &n) in counts.iter().enumerate() {
+        for (groups, &n) in self.groups.iter_mut().zip(&self.counts) {
             let used = n as usize % LANES;
             if used > 0 {
-                let last = &mut self.groups[(self.start[colour] + n / LANES as u32) as usize];
+                let last = &mut groups[n as usize / LANES];
                 last.live[used..].fill(false);
                 last.immovable[used..].fill(false);
                 // An empty lane still reads a circle: circle 0, which a step with pairs has.
@@ -112,25 +114,23 @@ impl Colours {
                 last.b[used..].fill(0);
             }
         }
-        let mut next = [0u32; MAX_COLOURS as usize];
-        for (k, (c, &colour)) in pairs.iter().zip(&self.colour).enumerate() {
-            if colour < MAX_COLOURS {
-                let at = &mut next[colour as usize];
-                let group = self.start[colour as usize] + *at / LANES as u32;
-                fill(
-                    &mut self.groups[group as usize],
-                    (*at as usize) % LANES,
-                    k,
-                    c,
-                );
-                *at += 1;
-            }
-        }
+    }
+
+    /// This step's groups of each colour, colour after colour.
+    pub fn groups_mut(&mut self) -> impl Iterator<Item = &mut [Group]> {
+        let each = self.groups.iter_mut().zip(&self.counts);
+        each.map(|(groups, &n)| &mut groups[..(n as usize).div_ceil(LANES)])
+    }
+
+    /// This step's groups, colour after colour.
+    pub fn groups(&self) -> impl Iterator<Item = &Group> {
+        let each = self.groups.iter().zip(&self.counts);
+        each.flat_map(|(groups, &n)| &groups[..(n as usize).div_ceil(LANES)])
     }
 
     /// Writes the groups' impulses back into `pairs`.
     pub fn unpack(&self, pairs: &mut [Constraint]) {
-        for g in &self.groups {
+        for g in self.groups() {
             for l in 0..LANES {
                 if g.live[l] {
                     let c = &mut pairs[g.contact[l] as usize];
@@ -178,10 +178,11 @@ pub enum Pass {
     },
 }
 
-/// One pass over `groups` on circles at `position` moving at `velocity`: with AVX2 where the
-/// processor has it, else lane by lane; the same result either way.
+/// One pass over the groups of `colours`, colour after colour, on circles at `position` moving
+/// at `velocity`: with AVX2 where the processor has it, else lane by lane; the same result
+/// either way.
 pub fn passes(
-    groups: &mut [Group],
+    colours: &mut Colours,
     position: &[DVec2],
     velocity: &mut [DVec2],
     pass: Pass,
@@ -190,20 +191,20 @@ pub fn passes(
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") {
         // SAFETY: the processor has AVX2, all that `wide::passes` asks of it.
-        return unsafe { wide::passes(groups, position, velocity, pass, work) };
+        return unsafe { wide::passes(colours, position, velocity, pass, work) };
     }
-    passes_by_lane(groups, position, velocity, pass, work);
+    passes_by_lane(colours, position, velocity, pass, work);
 }
 
 /// [`passes`] lane by lane: what any processor runs.
 pub fn passes_by_lane(
-    groups: &mut [Group],
+    colours: &mut Colours,
     position: &[DVec2],
     velocity: &mut [DVec2],
     pass: Pass,
     work: &mut Work,
 ) {
-    for g in groups {
+    for g in colours.groups_mut().flatten() {
         each_group(g, position, velocity, pass, work);
     }
 }

@@ -253,7 +253,7 @@ fn colour_pass(
     let Bodies {
         position, velocity, ..
     } = bodies;
-    passes(&mut colours.groups, position, velocity, pass, work);
+    passes(colours, position, velocity, pass, work);
     for &k in &colours.rest {
         let c = &mut pairs[k as usize];
         match pass {

@@ -12,19 +12,19 @@ use std::arch::x86_64::{
 
 use bevy::math::DVec2;
 
-use super::{Group, LANES, Pass, immovable_work};
+use super::{Colours, Group, LANES, Pass, immovable_work};
 use crate::soft::stats::Work;
 
 /// [`super::passes`] for a processor with AVX2.
 #[target_feature(enable = "avx2")]
 pub fn passes(
-    groups: &mut [Group],
+    colours: &mut Colours,
     position: &[DVec2],
     velocity: &mut [DVec2],
     pass: Pass,
     work: &mut Work,
 ) {
-    for g in groups {
+    for g in colours.groups_mut().flatten() {
         if g.live[LANES - 1] {
             each_group(g, position, velocity, pass, work);
         } else {
