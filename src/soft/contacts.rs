@@ -296,12 +296,12 @@ pub fn find_contacts(
     }
     // Arena walls if it has them; segment walls also in an open arena.
     let axes = if arena.has_walls() { 0..2 } else { 0..0 };
-    for i in 0..bodies.len() {
+    for (i, &travel) in travel.iter().enumerate() {
         if bodies.inv_mass[i] == 0.0 {
             continue; // immovable circles are kept inside by whoever steers them
         }
         let (p, r) = (bodies.position[i], bodies.radius[i]);
-        let limit = r * SPECULATIVE_MARGIN + travel[i];
+        let limit = r * SPECULATIVE_MARGIN + travel;
         for axis in axes.clone() {
             for high in [false, true] {
                 let wall = ArenaWall::on_axis(axis, high);
