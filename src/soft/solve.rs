@@ -188,9 +188,8 @@ fn soft_part(
     cache.warm_start(&bodies.id, walls, rows);
     cache.warm_start(&bodies.id, pairs, rows);
     let mut work = Work::default();
-    let rows_empty = rows.is_empty();
     let (dv, drag) = (params.gravity * h, (-params.drag * h).exp());
-    if rows_empty {
+    if rows.is_empty() {
         // A step without friction solves its pairs colour by colour, four at a time.
         colours.pack(bodies.len(), pairs);
         for _ in 0..substeps {
@@ -232,15 +231,15 @@ fn coloured_substep(
         warm_start_one::<false, true>(bodies, c, &[], work);
     }
     colour_pass(bodies, (pairs, colours), Pass::WarmStart, work);
-    for bias in [true, false] {
-        if !bias {
-            integrate_positions(bodies, h);
-        }
+    let mut solve_all = |bodies: &mut Bodies, bias: bool, work: &mut Work| {
         for c in walls.iter_mut() {
             solve_one::<false, true>(bodies, (c, &mut []), inv_h, bias, work);
         }
         colour_pass(bodies, (pairs, colours), Pass::Solve { inv_h, bias }, work);
-    }
+    };
+    solve_all(bodies, true, work);
+    integrate_positions(bodies, h);
+    solve_all(bodies, false, work);
 }
 
 /// One pass over the groups of `colours`, then over the pairs that found no colour.

@@ -34,7 +34,7 @@ pub fn passes(
     }
 }
 
-/// Lane `l` of a group's field.
+/// A group's field, its four lanes in one register.
 #[inline]
 #[target_feature(enable = "avx2")]
 fn load(field: &[f64; LANES]) -> __m256d {
