@@ -28,9 +28,9 @@ pub const MAX_COLOURS: u32 = 64;
 /// empty (`live` false) and writes nothing. Only a colour's last group can have empty lanes.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(32))]
-pub struct Group {
+struct Group {
     /// Each lane's contact, as its index in the step's pairs.
-    pub contact: [u32; LANES],
+    contact: [u32; LANES],
     live: [bool; LANES],
     a: [u32; LANES],
     b: [u32; LANES],
@@ -117,13 +117,13 @@ impl Colours {
     }
 
     /// This step's groups of each colour, colour after colour.
-    pub fn groups_mut(&mut self) -> impl Iterator<Item = &mut [Group]> {
+    fn groups_mut(&mut self) -> impl Iterator<Item = &mut [Group]> {
         let each = self.groups.iter_mut().zip(&self.counts);
         each.map(|(groups, &n)| &mut groups[..(n as usize).div_ceil(LANES)])
     }
 
     /// This step's groups, colour after colour.
-    pub fn groups(&self) -> impl Iterator<Item = &Group> {
+    fn groups(&self) -> impl Iterator<Item = &Group> {
         let each = self.groups.iter().zip(&self.counts);
         each.flat_map(|(groups, &n)| &groups[..(n as usize).div_ceil(LANES)])
     }
@@ -197,7 +197,7 @@ pub fn passes(
 }
 
 /// [`passes`] lane by lane: what any processor runs.
-pub fn passes_by_lane(
+fn passes_by_lane(
     colours: &mut Colours,
     position: &[DVec2],
     velocity: &mut [DVec2],
