@@ -1,6 +1,6 @@
 //! A frictionless step's pair contacts solved colour by colour, four at a time: contacts are
 //! coloured greedily in their order (no two of a colour move the same circle), each colour cut
-//! into [`Group`]s of four, and a pass solves group after group. The four contacts of a group
+//! into groups of four, and a pass solves group after group. The four contacts of a group
 //! share no movable circle, so they are worked out side by side: in AVX2 vector instructions
 //! where the processor has them (`wide`), else lane by lane, with the same operations in the same
 //! order (no fused multiply-add), so both give the same result bit for bit (a test compares
