@@ -286,8 +286,8 @@ mod tests {
             }
             let (mut list, mut any_order) = (PairList::default(), PairList::default());
             for step in 0..300 {
-                // Drifts of up to a fiftieth of a radius, a reach that grows now and then, and a jump across the arena
-                // (wrapped on the periodic one) every 50 steps.
+                // Drifts of up to a fiftieth of a radius, a reach that grows now and then, and
+                // a jump across the arena (wrapped on the periodic one) every 50 steps.
                 for (k, (p, r)) in circles.iter_mut().enumerate() {
                     let drift =
                         DVec2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));

@@ -230,7 +230,6 @@ fn each_group(
         Pass::WarmStart => {
             for l in 0..LANES {
                 j[l] = larger(g.impulse[l], 0.0);
-                g.total_impulse[l] += j[l];
             }
         }
         Pass::Solve { inv_h, bias } => {
@@ -265,12 +264,12 @@ fn each_group(
                 let total = larger(g.impulse[l] + step, 0.0);
                 j[l] = total - g.impulse[l];
                 g.impulse[l] = total;
-                g.total_impulse[l] += j[l];
             }
         }
     }
     let (mut px, mut py) = (zero, zero);
     for l in 0..LANES {
+        g.total_impulse[l] += j[l];
         px[l] = g.normal_x[l] * j[l];
         py[l] = g.normal_y[l] * j[l];
     }
