@@ -29,16 +29,26 @@ struct Cached {
     rolling: f64,
 }
 
-/// The impulses of last step's contacts, by circle: what warm starting starts from.
+/// The impulses of last step's contacts: what warm starting starts from. Kept in the order the
+/// step stored them, which is the order the next step finds them in but for the contacts that
+/// came, went or moved: a contact is looked for where the one before it was found, and only
+/// when it is not there, by its circle (an index by circle made for that step, at most once).
 #[derive(Default)]
 pub struct ContactCache {
     /// Each circle's identity last step, by its index then.
     ids: Vec<u64>,
-    /// `entries[start[i]..start[i + 1]]` are circle `i`'s contacts (as their `a`).
+    /// Last step's contacts in their order, each with its first circle's index then.
+    stored: Vec<(u32, Cached)>,
+    /// Where the next contact is looked for first in `stored`.
+    cursor: usize,
+    /// `stored[by_circle[start[i]..start[i + 1]]]` are circle `i`'s contacts (as their `a`),
+    /// in their order; empty until a contact is not where it was looked for.
     start: Vec<u32>,
-    entries: Vec<Cached>,
+    by_circle: Vec<u32>,
     /// Last step's index of each identity, built only when the circles changed order.
     index_of: HashMap<u64, u32>,
+    /// Whether a step has stored (or a checkpoint restored) it.
+    stepped: bool,
 }
 
 impl ContactCache {
@@ -49,14 +59,15 @@ impl ContactCache {
 
     /// Gives every contact in `constraints` the impulse it ended last step with, and whether
     /// it pushed then (and its row in `rows`, if it has friction, the friction and rolling
-    /// impulses it ended with). `ids` are the circles' identities now.
+    /// impulses it ended with). `ids` are the circles' identities now. A step calls it for its
+    /// contacts in the order it stores them.
     pub fn warm_start(
         &mut self,
         ids: &[u64],
         constraints: &mut [Constraint],
         rows: &mut [TurningRow],
     ) {
-        if self.entries.is_empty() {
+        if self.stored.is_empty() {
             return;
         }
         let same_order = self.ids == ids;
@@ -71,28 +82,50 @@ impl ContactCache {
         for c in constraints.iter_mut() {
             let a = c.a as usize;
             let old = if same_order {
-                Some(a)
+                Some(a as u32)
             } else {
-                self.index_of.get(&ids[a]).map(|&i| i as usize)
+                self.index_of.get(&ids[a]).copied()
             };
             let Some(old) = old else { continue };
-            let (from, to) = (self.start[old] as usize, self.start[old + 1] as usize);
-            if let Some(hit) = self.entries[from..to]
-                .iter()
-                .find(|e| e.partner == c.partner)
-            {
-                c.impulse = hit.impulse;
-                c.was_touching = hit.touching;
-                if c.turn != NONE {
-                    // Within what the contact allows now: friction or rolling resistance
-                    // switched off (or a forged checkpoint) must not leave a push no row takes
-                    // back.
-                    let row = &mut rows[c.turn as usize];
-                    let (most_tangent, most_rolling) = row.bounds(c.impulse);
-                    row.tangent_impulse = hit.tangent.clamp(-most_tangent, most_tangent);
-                    row.rolling_impulse = hit.rolling.clamp(-most_rolling, most_rolling);
-                }
+            let Some(k) = self.find(old, c.partner) else {
+                continue;
+            };
+            self.cursor = k + 1;
+            let hit = self.stored[k].1;
+            c.impulse = hit.impulse;
+            c.was_touching = hit.touching;
+            if c.turn != NONE {
+                // Within what the contact allows now: friction or rolling resistance switched
+                // off (or a forged checkpoint) must not leave a push no row takes back.
+                let row = &mut rows[c.turn as usize];
+                let (most_tangent, most_rolling) = row.bounds(c.impulse);
+                row.tangent_impulse = hit.tangent.clamp(-most_tangent, most_tangent);
+                row.rolling_impulse = hit.rolling.clamp(-most_rolling, most_rolling);
             }
+        }
+    }
+
+    /// Where in `stored` circle `old`'s contact with `partner` is: at the cursor or just past
+    /// it (a contact gone), else by its circle.
+    fn find(&mut self, old: u32, partner: Partner) -> Option<usize> {
+        let is = |e: &(u32, Cached)| e.0 == old && e.1.partner == partner;
+        let near = self.cursor..(self.cursor + 2).min(self.stored.len());
+        if let Some(k) = near.clone().find(|&k| is(&self.stored[k])) {
+            return Some(k);
+        }
+        self.index_by_circle();
+        let old = old as usize;
+        let mine = &self.by_circle[self.start[old] as usize..self.start[old + 1] as usize];
+        mine.iter()
+            .map(|&k| k as usize)
+            .find(|&k| is(&self.stored[k]))
+    }
+
+    /// Lists `stored` by circle, if not yet done since it was stored.
+    fn index_by_circle(&mut self) {
+        if self.start.is_empty() {
+            let n = self.ids.len();
+            by_circle(&self.stored, n, (&mut self.start, &mut self.by_circle));
         }
     }
 
@@ -100,9 +133,11 @@ impl ContactCache {
     /// each one's contacts in that order, partners by their index in it. `None` before the
     /// first step (there is nothing to warm start from).
     pub fn snapshot(&self, order: &[u64]) -> Option<CacheSnapshot> {
-        if self.start.is_empty() {
+        if !self.stepped {
             return None;
         }
+        let (mut start, mut listed) = (Vec::new(), Vec::new());
+        by_circle(&self.stored, self.ids.len(), (&mut start, &mut listed));
         let position: HashMap<u64, u32> = order
             .iter()
             .enumerate()
@@ -118,8 +153,9 @@ impl ContactCache {
         for id in order {
             let before = snapshot.entries.len();
             if let Some(&old) = cached.get(id) {
-                let mine = &self.entries[self.start[old] as usize..self.start[old + 1] as usize];
-                snapshot.entries.extend(mine.iter().filter_map(|e| {
+                let mine = &listed[start[old] as usize..start[old + 1] as usize];
+                let mine = mine.iter().map(|&k| &self.stored[k as usize].1);
+                snapshot.entries.extend(mine.filter_map(|e| {
                     let partner = match e.partner {
                         Partner::Circle(id) => SnapshotPartner::Circle(*position.get(&id)?),
                         Partner::Wall(wall) => SnapshotPartner::Wall(wall),
@@ -144,79 +180,90 @@ impl ContactCache {
     /// checkpoint lists them). Fails, saying why, if it does not fit them.
     pub fn restore(snapshot: &CacheSnapshot, ids: &[u64]) -> Result<Self, String> {
         snapshot.check_lists(ids.len())?;
-        let mut start = Vec::with_capacity(ids.len() + 1);
-        start.push(0u32);
-        for &count in &snapshot.counts {
-            start.push(start.last().copied().unwrap_or(0) + count);
-        }
-        let entries = snapshot
-            .entries
+        let owners = snapshot
+            .counts
             .iter()
-            .map(|e| Cached {
-                partner: match e.partner {
-                    SnapshotPartner::Circle(k) => Partner::Circle(ids[k as usize]),
-                    SnapshotPartner::Wall(wall) => Partner::Wall(wall),
-                },
-                impulse: e.impulse,
-                touching: e.touching,
-                tangent: e.tangent,
-                rolling: e.rolling,
+            .enumerate()
+            .flat_map(|(i, &count)| std::iter::repeat_n(i as u32, count as usize));
+        let stored = owners
+            .zip(&snapshot.entries)
+            .map(|(i, e)| {
+                let cached = Cached {
+                    partner: match e.partner {
+                        SnapshotPartner::Circle(k) => Partner::Circle(ids[k as usize]),
+                        SnapshotPartner::Wall(wall) => Partner::Wall(wall),
+                    },
+                    impulse: e.impulse,
+                    touching: e.touching,
+                    tangent: e.tangent,
+                    rolling: e.rolling,
+                };
+                (i, cached)
             })
             .collect();
         Ok(Self {
             ids: ids.to_vec(),
-            start,
-            entries,
-            index_of: HashMap::default(),
+            stored,
+            stepped: true,
+            ..Self::default()
         })
     }
 
-    /// Keeps the impulses `constraints` (and their `rows`) ended the step with, for the next
-    /// step's [`ContactCache::warm_start`].
+    /// Keeps the impulses `constraints` (and their `rows`) ended the step with, in their
+    /// order, for the next step's [`ContactCache::warm_start`].
     pub fn store<'a>(
         &mut self,
         ids: &[u64],
-        constraints: impl Iterator<Item = &'a Constraint> + Clone,
+        constraints: impl Iterator<Item = &'a Constraint>,
         rows: &[TurningRow],
     ) {
         self.ids.clear();
         self.ids.extend_from_slice(ids);
         self.index_of.clear();
-        // A counting sort by circle, each circle's contacts in the order given.
         self.start.clear();
-        self.start.resize(ids.len() + 1, 0);
-        for c in constraints.clone() {
-            self.start[c.a as usize + 1] += 1;
-        }
-        for i in 0..ids.len() {
-            self.start[i + 1] += self.start[i];
-        }
-        let mut next = self.start.clone();
-        let empty = Cached {
-            partner: Partner::Wall(Wall::Segment(0)),
-            impulse: 0.0,
-            touching: false,
-            tangent: 0.0,
-            rolling: 0.0,
-        };
-        self.entries.clear();
-        self.entries.resize(self.start[ids.len()] as usize, empty);
-        for c in constraints {
+        self.cursor = 0;
+        self.stepped = true;
+        self.stored.clear();
+        self.stored.extend(constraints.map(|c| {
             let (tangent, rolling) = match rows.get(c.turn as usize) {
                 Some(row) => (row.tangent_impulse, row.rolling_impulse),
                 None => (0.0, 0.0),
             };
-            let slot = &mut next[c.a as usize];
-            self.entries[*slot as usize] = Cached {
+            let cached = Cached {
                 partner: c.partner,
                 impulse: c.impulse,
                 touching: c.total_impulse > 0.0,
                 tangent,
                 rolling,
             };
-            *slot += 1;
-        }
+            (c.a, cached)
+        }));
     }
+}
+
+/// Where each circle's contacts are in `stored` (whose first circles are below `n`), into
+/// `start` and `listed`: circle `i`'s are `stored[listed[start[i]..start[i + 1]]]`, in their
+/// order (a counting sort).
+fn by_circle(stored: &[(u32, Cached)], n: usize, (start, listed): (&mut Vec<u32>, &mut Vec<u32>)) {
+    start.clear();
+    start.resize(n + 1, 0);
+    for &(a, _) in stored {
+        start[a as usize + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    listed.clear();
+    listed.resize(stored.len(), 0);
+    // Each circle's start serves as its next free place, which leaves it at the next
+    // circle's start: shifted back by one place after.
+    for (k, &(a, _)) in stored.iter().enumerate() {
+        let next = &mut start[a as usize];
+        listed[*next as usize] = k as u32;
+        *next += 1;
+    }
+    start.rotate_right(1);
+    start[0] = 0;
 }
 
 /// A contact's other side in a [`CacheSnapshot`]: a circle by its index.
@@ -333,6 +380,83 @@ mod tests {
     use bevy::math::DVec2;
 
     use super::*;
+
+    /// A contact of circle `a` with circle `b` (by index, identity `b`) or, for `b` past the
+    /// circles, with segment wall `b`.
+    fn contact(a: u32, b: u32, impulse: f64) -> Constraint {
+        let partner = match b {
+            0..8 => Partner::Circle(u64::from(b)),
+            _ => Partner::Wall(Wall::Segment(b)),
+        };
+        Constraint {
+            a,
+            b: if b < 8 { b } else { NONE },
+            partner,
+            normal: DVec2::X,
+            anchor: DVec2::ZERO,
+            reach: 1.0,
+            inv_mass: (1.0, 1.0),
+            normal_mass: 0.5,
+            soft: super::super::Softness::new(30.0, 10.0, 1.0 / 240.0),
+            restitution: 0.0,
+            threshold: 0.0,
+            push: 1.0,
+            relative_velocity: 0.0,
+            impulse,
+            total_impulse: impulse,
+            approach: 0.0,
+            was_touching: false,
+            turn: NONE,
+        }
+    }
+
+    #[test]
+    fn each_contact_warm_starts_from_its_own_impulse_whatever_came_went_or_moved() {
+        let ids: Vec<u64> = (0..8).collect();
+        // Last step: every pair (a, b), a < b, of 8 circles and a wall each, in a fixed
+        // order; its impulse names it.
+        let named = |a: u32, b: u32| f64::from(a * 100 + b);
+        let mut last: Vec<Constraint> = (0..8)
+            .flat_map(|a| (a + 1..8).chain([20 + a]).map(move |b| (a, b)))
+            .map(|(a, b)| contact(a, b, named(a, b)))
+            .collect();
+        let mut cache = ContactCache::default();
+        cache.store(&ids, last.iter(), &[]);
+        // This step: some gone, some new, a block moved far, neighbours swapped; in two
+        // calls, as a step warm starts its walls and then its pairs.
+        last.retain(|c| (c.a + c.b) % 5 != 0);
+        last.rotate_left(7);
+        last.swap(3, 4);
+        last.extend([contact(0, 30, 0.0), contact(5, 31, 0.0)]);
+        let mut now: Vec<Constraint> = last.iter().map(|c| contact(c.a, c.b, -1.0)).collect();
+        let (first, second) = now.split_at_mut(10);
+        cache.warm_start(&ids, first, &mut []);
+        cache.warm_start(&ids, second, &mut []);
+        for c in &now {
+            let expected = match c.partner {
+                Partner::Circle(b) => named(c.a, b as u32),
+                Partner::Wall(Wall::Segment(w)) if w < 30 => named(c.a, w),
+                Partner::Wall(_) => -1.0,
+            };
+            assert_eq!(c.impulse, expected, "contact {} {:?}", c.a, c.partner);
+        }
+        // With the circles in another order the same contacts are found by identity.
+        let reversed: Vec<u64> = ids.iter().rev().copied().collect();
+        let mut renamed: Vec<Constraint> =
+            now.iter().map(|c| contact(7 - c.a, c.b, -1.0)).collect();
+        let (first, second) = renamed.split_at_mut(5);
+        cache.warm_start(&reversed, first, &mut []);
+        cache.warm_start(&reversed, second, &mut []);
+        for (c, was) in renamed.iter().zip(&now) {
+            assert_eq!(c.impulse, was.impulse, "contact {} {:?}", c.a, c.partner);
+        }
+        // Where the contact looked for first has the same partner but another circle.
+        let two = [contact(0, 5, 1.0), contact(1, 5, 2.0)];
+        cache.store(&ids, two.iter(), &[]);
+        let mut one = [contact(1, 5, -1.0)];
+        cache.warm_start(&ids, &mut one, &mut []);
+        assert_eq!(one[0].impulse, 2.0);
+    }
 
     #[test]
     fn a_cached_impulse_beyond_any_speed_is_refused() {
