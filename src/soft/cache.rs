@@ -37,8 +37,9 @@ struct Cached {
 pub struct ContactCache {
     /// Each circle's identity last step, by its index then.
     ids: Vec<u64>,
-    /// Last step's contacts in their order, each with its first circle's index then.
-    stored: Vec<(u32, Cached)>,
+    /// Last step's contacts in their order, and each one's first circle (its index then).
+    stored: Vec<Cached>,
+    owners: Vec<u32>,
     /// Where the next contact is looked for first in `stored`.
     cursor: usize,
     /// `stored[by_circle[start[i]..start[i + 1]]]` are circle `i`'s contacts (as their `a`),
@@ -91,7 +92,7 @@ impl ContactCache {
                 continue;
             };
             self.cursor = k + 1;
-            let hit = self.stored[k].1;
+            let hit = self.stored[k];
             c.impulse = hit.impulse;
             c.was_touching = hit.touching;
             if c.turn != NONE {
@@ -108,24 +109,22 @@ impl ContactCache {
     /// Where in `stored` circle `old`'s contact with `partner` is: at the cursor or just past
     /// it (a contact gone), else by its circle.
     fn find(&mut self, old: u32, partner: Partner) -> Option<usize> {
-        let is = |e: &(u32, Cached)| e.0 == old && e.1.partner == partner;
+        let is = |cache: &Self, k: usize| cache.owners[k] == old && cache.stored[k].partner == partner;
         let near = self.cursor..(self.cursor + 2).min(self.stored.len());
-        if let Some(k) = near.clone().find(|&k| is(&self.stored[k])) {
+        if let Some(k) = near.clone().find(|&k| is(self, k)) {
             return Some(k);
         }
         self.index_by_circle();
         let old = old as usize;
         let mine = &self.by_circle[self.start[old] as usize..self.start[old + 1] as usize];
-        mine.iter()
-            .map(|&k| k as usize)
-            .find(|&k| is(&self.stored[k]))
+        mine.iter().map(|&k| k as usize).find(|&k| is(self, k))
     }
 
     /// Lists `stored` by circle, if not yet done since it was stored.
     fn index_by_circle(&mut self) {
         if self.start.is_empty() {
             let n = self.ids.len();
-            by_circle(&self.stored, n, (&mut self.start, &mut self.by_circle));
+            by_circle(&self.owners, n, (&mut self.start, &mut self.by_circle));
         }
     }
 
@@ -137,7 +136,7 @@ impl ContactCache {
             return None;
         }
         let (mut start, mut listed) = (Vec::new(), Vec::new());
-        by_circle(&self.stored, self.ids.len(), (&mut start, &mut listed));
+        by_circle(&self.owners, self.ids.len(), (&mut start, &mut listed));
         let position: HashMap<u64, u32> = order
             .iter()
             .enumerate()
@@ -154,7 +153,7 @@ impl ContactCache {
             let before = snapshot.entries.len();
             if let Some(&old) = cached.get(id) {
                 let mine = &listed[start[old] as usize..start[old + 1] as usize];
-                let mine = mine.iter().map(|&k| &self.stored[k as usize].1);
+                let mine = mine.iter().map(|&k| &self.stored[k as usize]);
                 snapshot.entries.extend(mine.filter_map(|e| {
                     let partner = match e.partner {
                         Partner::Circle(id) => SnapshotPartner::Circle(*position.get(&id)?),
@@ -185,25 +184,20 @@ impl ContactCache {
             .iter()
             .enumerate()
             .flat_map(|(i, &count)| std::iter::repeat_n(i as u32, count as usize));
-        let stored = owners
-            .zip(&snapshot.entries)
-            .map(|(i, e)| {
-                let cached = Cached {
-                    partner: match e.partner {
-                        SnapshotPartner::Circle(k) => Partner::Circle(ids[k as usize]),
-                        SnapshotPartner::Wall(wall) => Partner::Wall(wall),
-                    },
-                    impulse: e.impulse,
-                    touching: e.touching,
-                    tangent: e.tangent,
-                    rolling: e.rolling,
-                };
-                (i, cached)
-            })
-            .collect();
+        let stored = snapshot.entries.iter().map(|e| Cached {
+            partner: match e.partner {
+                SnapshotPartner::Circle(k) => Partner::Circle(ids[k as usize]),
+                SnapshotPartner::Wall(wall) => Partner::Wall(wall),
+            },
+            impulse: e.impulse,
+            touching: e.touching,
+            tangent: e.tangent,
+            rolling: e.rolling,
+        });
         Ok(Self {
             ids: ids.to_vec(),
-            stored,
+            stored: stored.collect(),
+            owners: owners.collect(),
             stepped: true,
             ..Self::default()
         })
@@ -224,40 +218,41 @@ impl ContactCache {
         self.cursor = 0;
         self.stepped = true;
         self.stored.clear();
-        self.stored.extend(constraints.map(|c| {
+        self.owners.clear();
+        for c in constraints {
             let (tangent, rolling) = match rows.get(c.turn as usize) {
                 Some(row) => (row.tangent_impulse, row.rolling_impulse),
                 None => (0.0, 0.0),
             };
-            let cached = Cached {
+            self.owners.push(c.a);
+            self.stored.push(Cached {
                 partner: c.partner,
                 impulse: c.impulse,
                 touching: c.total_impulse > 0.0,
                 tangent,
                 rolling,
-            };
-            (c.a, cached)
-        }));
+            });
+        }
     }
 }
 
-/// Where each circle's contacts are in `stored` (whose first circles are below `n`), into
-/// `start` and `listed`: circle `i`'s are `stored[listed[start[i]..start[i + 1]]]`, in their
-/// order (a counting sort).
-fn by_circle(stored: &[(u32, Cached)], n: usize, (start, listed): (&mut Vec<u32>, &mut Vec<u32>)) {
+/// Where each circle's contacts are among contacts whose first circles are `owners` (all below
+/// `n`), into `start` and `listed`: circle `i`'s are those at `listed[start[i]..start[i + 1]]`,
+/// in their order (a counting sort).
+fn by_circle(owners: &[u32], n: usize, (start, listed): (&mut Vec<u32>, &mut Vec<u32>)) {
     start.clear();
     start.resize(n + 1, 0);
-    for &(a, _) in stored {
+    for &a in owners {
         start[a as usize + 1] += 1;
     }
     for i in 0..n {
         start[i + 1] += start[i];
     }
     listed.clear();
-    listed.resize(stored.len(), 0);
+    listed.resize(owners.len(), 0);
     // Each circle's start serves as its next free place, which leaves it at the next
     // circle's start: shifted back by one place after.
-    for (k, &(a, _)) in stored.iter().enumerate() {
+    for (k, &a) in owners.iter().enumerate() {
         let next = &mut start[a as usize];
         listed[*next as usize] = k as u32;
         *next += 1;
