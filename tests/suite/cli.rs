@@ -208,6 +208,40 @@ fn a_closed_stdout_is_not_a_crash() {
 }
 
 #[test]
+fn the_contact_solver_gives_the_same_state_with_and_without_vector_instructions() {
+    // The pyramid's 210 stacked circles under `soft`, frictionless: its pairs go through the
+    // colour passes, four at a time, in AVX2 where the processor has it unless told not to.
+    let dir = temp_dir("vector");
+    let mut dumps = Vec::new();
+    for (vector, threads) in [("on", "2"), ("off", "1"), ("off", "2")] {
+        let dump = dir.join(format!("vector-{vector}-{threads}.txt"));
+        moving_circles(&[
+            "run",
+            "--scene",
+            "assets/scenes/pyramid.ron",
+            "--steps",
+            "120",
+            "--vector",
+            vector,
+            "--threads",
+            threads,
+            "--dump",
+            dump.to_str().unwrap(),
+        ]);
+        dumps.push(std::fs::read_to_string(&dump).unwrap());
+    }
+    assert_eq!(
+        dumps[0].lines().count(),
+        211,
+        "a count line and 210 circles"
+    );
+    for (k, dump) in dumps.iter().enumerate().skip(1) {
+        assert!(*dump == dumps[0], "run {k} differs from the vector run");
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
 fn the_final_state_does_not_depend_on_the_number_of_threads() {
     // 10k circles: above the size from which the broad phase and the contact pass go parallel.
     let dir = temp_dir("threads");

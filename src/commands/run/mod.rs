@@ -32,6 +32,9 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
         bail!("--every must be at least 1");
     }
     let interrupts = Interrupts::install()?;
+    // Before any App, resumed or new, is made: neither changes a result.
+    set_threads(options.threads);
+    crate::soft::colours::use_vector_passes(options.vector);
     let (mut app, mut progress, source, dt) = match &options.input {
         Input::Resume(path) => {
             let spawn = options.placement.is_some() || options.area_fraction.is_some();
@@ -68,7 +71,6 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
                 ));
             }
             let dt = config.dt;
-            set_threads(options.threads);
             let Some(mut app) = start(config, &source, interrupts.stop_request())? else {
                 // Nothing was run: every output is left as it was.
                 let signal = interrupts.raised().unwrap_or_default();
