@@ -191,6 +191,7 @@ pub mod sleep;
 pub mod soft;
 pub mod spawn;
 pub mod transform_sync;
+pub mod vector;
 
 use bevy::app::{PluginGroup, PluginGroupBuilder};
 

@@ -159,8 +159,9 @@ struct RunArgs {
     /// on it.
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=i64::from(MAX_THREADS)))]
     threads: Option<u16>,
-    /// Whether the `soft` solver may use the processor's vector instructions (AVX2) where it
-    /// has them. Results do not depend on it: `off` is there to show that.
+    /// Whether the kernels (`soft`'s contact passes, `exact`'s pair times) may use the
+    /// processor's vector instructions (AVX2) where it has them. Results do not depend on it:
+    /// `off` is there to show that.
     #[arg(long, value_name = "on|off", default_value = "on", value_parser = ["on", "off"])]
     vector: String,
     /// Write a checkpoint (the whole state, to go on from with `--resume`) here: at the end,

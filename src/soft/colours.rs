@@ -10,8 +10,6 @@
 //! The colours change the order of the Gauss-Seidel passes from the broad phase's, and with it
 //! how fast a pile settles (measured in `docs/piles.md`).
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use bevy::math::DVec2;
 
 use super::contacts::{Constraint, larger};
@@ -180,19 +178,8 @@ pub enum Pass {
     },
 }
 
-/// Whether the passes may use the processor's vector instructions: see [`use_vector_passes`].
-static VECTOR_PASSES: AtomicBool = AtomicBool::new(true);
-
-/// Lets the passes use the processor's vector instructions where it has them (`true`, the
-/// default), or has them go lane by lane on any processor (`false`), for this whole process.
-/// Both give the same result bit for bit: this is how a run shows it (`moving_circles run
-/// --vector off`).
-pub fn use_vector_passes(allowed: bool) {
-    VECTOR_PASSES.store(allowed, Ordering::Relaxed);
-}
-
 /// One pass over the groups of `colours`, colour after colour, on circles at `position` moving
-/// at `velocity`: with AVX2 where the processor has it (and [`use_vector_passes`] allows it),
+/// at `velocity`: with AVX2 where the processor has it (and [`crate::vector::allow`] lets it),
 /// else lane by lane; the same result either way.
 pub fn passes(
     colours: &mut Colours,
@@ -202,7 +189,7 @@ pub fn passes(
     work: &mut Work,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if VECTOR_PASSES.load(Ordering::Relaxed) && std::is_x86_feature_detected!("avx2") {
+    if crate::vector::avx2() {
         // SAFETY: the processor has AVX2, all that `wide::passes` asks of it.
         return unsafe { wide::passes(colours, position, velocity, pass, work) };
     }

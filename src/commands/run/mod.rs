@@ -34,7 +34,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     let interrupts = Interrupts::install()?;
     // Before any App, resumed or new, is made: neither changes a result.
     set_threads(options.threads);
-    crate::soft::colours::use_vector_passes(options.vector);
+    crate::vector::allow(options.vector);
     let (mut app, mut progress, source, dt) = match &options.input {
         Input::Resume(path) => {
             let spawn = options.placement.is_some() || options.area_fraction.is_some();

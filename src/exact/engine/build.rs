@@ -287,6 +287,8 @@ impl EventEngine {
             quick_hits: vec![0; n],
             anchor,
             spins: None,
+            #[cfg(target_arch = "x86_64")]
+            batch: None,
         })
     }
 }

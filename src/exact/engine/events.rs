@@ -1,5 +1,5 @@
-//! The records the event engine keeps per circle (its motion, its pending event, its best pair)
-//! and the counts and errors it reports.
+//! The records the event engine keeps per circle (its motion, its pending event, its best pair),
+//! a pair's relative motion, and the counts and errors it reports.
 
 use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
@@ -63,6 +63,50 @@ impl Motion {
     pub(super) fn at(&self, t: f64) -> DVec2 {
         self.pos + self.vel * (t - self.t_at)
     }
+}
+
+/// What a pair's time is worked out in: now, and the arena's period when it wraps.
+#[derive(Clone, Copy)]
+pub(super) struct Frame {
+    pub(super) now: f64,
+    pub(super) period: Option<DVec2>,
+}
+
+/// A pair's relative motion from the later of its two reference times (where one of the two
+/// is at its reference point: `at` adds nothing to it): that time, and the separation and
+/// relative velocity then, the separation through the image `image` picks from where they are
+/// now relative to each other, when the arena wraps (they may have flown far since).
+#[inline(always)]
+pub(super) fn relative(
+    me: &Motion,
+    other: &Motion,
+    frame: Frame,
+    image: impl Fn(DVec2) -> DVec2,
+) -> (f64, DVec2, DVec2) {
+    let since = me.t_at.max(other.t_at);
+    let mut dp = other.at(since) - me.at(since);
+    let dv = other.vel - me.vel;
+    if let Some(period) = frame.period {
+        dp -= period * image(dp + dv * (frame.now - since));
+    }
+    (since, dp, dv)
+}
+
+/// How many whole periods along each axis the displacement `d` is beyond its minimum image
+/// (`d` minus that many periods is within half a period); none when the arena does not wrap.
+#[inline]
+pub(super) fn nearest_image(d: DVec2, period: Option<DVec2>) -> DVec2 {
+    let Some(period) = period else {
+        return DVec2::ZERO;
+    };
+    let whole = |d: f64, period: f64| {
+        if d.abs() > 0.5 * period {
+            (d / period).round()
+        } else {
+            0.0
+        }
+    };
+    DVec2::new(whole(d.x, period.x), whole(d.y, period.y))
 }
 
 /// The soonest pair collision a circle's last look at its neighbours found.

@@ -20,6 +20,8 @@
 //! grow as the circles fly (`growth`). Under gravity, circles at rest on a support sleep and
 //! are woken by a hard hit (`rest`). Everything is f64.
 
+#[cfg(target_arch = "x86_64")]
+mod batch;
 mod build;
 mod events;
 mod growth;
@@ -126,6 +128,9 @@ pub struct EventEngine {
     anchor: Vec<(DVec2, f64)>,
     /// Each circle's turning, when hits are rough (`spin`); none when smooth.
     spins: Option<spin::Spins>,
+    /// Room for a scan's neighbours, kept from scan to scan (taken while one uses it).
+    #[cfg(target_arch = "x86_64")]
+    batch: Option<Box<batch::Batch>>,
 }
 
 impl EventEngine {

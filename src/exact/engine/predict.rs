@@ -18,7 +18,7 @@
 use bevy::math::DVec2;
 
 use super::EventEngine;
-use super::events::{BestPair, Event, Kind, Motion, NO_PAIR};
+use super::events::{BestPair, Event, Frame, Kind, Motion, NO_PAIR, nearest_image, relative};
 use crate::exact::fall::{exit_time, falling_pair_time, falling_segment_time};
 use crate::exact::toi::{
     growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact, wall_time_of_impact,
@@ -38,6 +38,26 @@ impl EventEngine {
         }
     }
 
+    /// [`EventEngine::scan`] over a whole block of cells: for circles on straight lines through
+    /// the nearest image, where the processor has AVX2, four pairs at a time
+    /// ([`super::batch`]; a few neighbours, as in the cells a crossing newly borders, are
+    /// cheaper one by one).
+    fn scan_block(&mut self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
+        #[cfg(target_arch = "x86_64")]
+        if self.gravity == DVec2::ZERO
+            && !self.images_wrap
+            && self.growth == 0.0
+            && crate::vector::avx2()
+        {
+            let mut batch = self.batch.take().unwrap_or_default();
+            // SAFETY: `crate::vector::avx2` says the processor has AVX2.
+            let best = unsafe { self.scan_straight(i, cells, &mut batch) };
+            self.batch = Some(batch);
+            return best;
+        }
+        self.scan(i, cells)
+    }
+
     /// [`EventEngine::scan`], with the parabolas of gravity when `FALL` (a separate loop, so
     /// that the straight-line one is exactly what it is without gravity).
     fn scan_with<const FALL: bool, const IMAGES: bool>(
@@ -45,6 +65,7 @@ impl EventEngine {
         i: usize,
         cells: impl IntoIterator<Item = usize>,
     ) -> BestPair {
+        let meets = self.meeting(i);
         let me = self.motion[i];
         let mut best = NO_PAIR;
         let nearest = |d: DVec2| self.nearest_image(d);
@@ -55,10 +76,6 @@ impl EventEngine {
                 self.look_at::<IMAGES>(&me, j, nearest, &mut best);
             }
         };
-        // With layers, a pair that does not meet has no event (a branch the same way for every
-        // neighbour without them; outside `look`, which must stay small enough to inline).
-        let mine = self.layers.get(i).copied();
-        let meets = |j: usize| mine.is_none_or(|mine| mine.meets(self.layers[j]));
         for c in cells {
             for j in self.cells.members(c) {
                 if j != i && meets(j) {
@@ -72,6 +89,16 @@ impl EventEngine {
             }
         }
         best
+    }
+
+    /// Whether circle `i` meets a circle `j`, under their layers, as a test of `j`. With layers,
+    /// a pair that does not meet has no event (a branch the same way for every neighbour
+    /// without them, kept apart from the pair's arithmetic, which must stay small enough to
+    /// inline).
+    #[inline(always)]
+    pub(super) fn meeting(&self, i: usize) -> impl Fn(usize) -> bool {
+        let mine = self.layers.get(i).copied();
+        move |j: usize| mine.is_none_or(|mine| mine.meets(self.layers[j]))
     }
 
     /// [`EventEngine::look_at`] under gravity: the pair's positions and velocities at the later
@@ -134,16 +161,11 @@ impl EventEngine {
     ) {
         let now = self.now;
         let other = &self.motion[j];
-        // From the later reference time, where one of the two is at its reference point
-        // (`at` adds nothing to it). Both are moved there, with no branch to mispredict.
-        let since = me.t_at.max(other.t_at);
-        let mut dp = other.at(since) - me.at(since);
-        let dv = other.vel - me.vel;
-        if self.grid.periodic {
-            // Through the image the pair is nearest in now: they may have flown far since
-            // `since`.
-            dp -= self.period * image(dp + dv * (now - since));
-        }
+        let frame = Frame {
+            now,
+            period: self.grid.periodic.then_some(self.period),
+        };
+        let (since, dp, dv) = relative(me, other, frame, image);
         let sum = me.radius + other.radius;
         let impact = if IMAGES && self.growth == 0.0 {
             (-2..=2)
@@ -185,10 +207,10 @@ impl EventEngine {
             let block = [c - cols, c, c + cols]
                 .into_iter()
                 .flat_map(|middle| [middle - 1, middle, middle + 1]);
-            self.scan(i, block)
+            self.scan_block(i, block)
         } else {
             let (cells, len) = self.grid.block(x, y);
-            self.scan(i, cells[..len].iter().copied())
+            self.scan_block(i, cells[..len].iter().copied())
         };
         self.schedule(i);
     }
@@ -388,14 +410,7 @@ impl EventEngine {
     /// (`d` minus that many periods is within half a period).
     #[inline]
     pub(super) fn nearest_image(&self, d: DVec2) -> DVec2 {
-        let whole = |d: f64, period: f64| {
-            if d.abs() > 0.5 * period {
-                (d / period).round()
-            } else {
-                0.0
-            }
-        };
-        DVec2::new(whole(d.x, self.period.x), whole(d.y, self.period.y))
+        nearest_image(d, Some(self.period))
     }
 }
 

@@ -212,6 +212,8 @@ impl EventEngine {
             quick_hits: s.quick_hits,
             anchor: s.anchor,
             spins: s.spins,
+            #[cfg(target_arch = "x86_64")]
+            batch: None,
         };
         engine.check_pending(&stored.0, &stored.1)?;
         engine.check_best_pairs()?;
