@@ -94,12 +94,8 @@ impl EventEngine {
             }
         };
         let meets = self.meeting(i);
-        let others = cells
-            .into_iter()
-            .flat_map(|c| self.cells.members(c))
-            .chain(self.large.iter().map(|&j| j as usize));
         let (mut len, mut best) = (0, NO_PAIR);
-        for j in others {
+        let mut take = |j: usize| {
             if j != i && meets(j) {
                 batch.set(len, j, &self.motion[j]);
                 len += 1;
@@ -108,6 +104,16 @@ impl EventEngine {
                     len = 0;
                 }
             }
+        };
+        // Nested loops, not one chained iterator: that one checks which part it is in at
+        // every neighbour.
+        for c in cells {
+            for j in self.cells.members(c) {
+                take(j);
+            }
+        }
+        for &j in &self.large {
+            take(j as usize);
         }
         settle(batch, len, &mut best);
         best
