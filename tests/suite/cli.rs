@@ -207,13 +207,10 @@ fn a_closed_stdout_is_not_a_crash() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The final states of `run ARGS --dump` with vector instructions allowed on two threads, and
-/// not allowed on one and on two, each with `lines` lines (in a scratch folder named `name`).
-fn dumps_with_and_without_vector_instructions(
-    name: &str,
-    args: &[&str],
-    lines: usize,
-) -> Vec<String> {
+/// Checks that the final states of `run ARGS --dump` with vector instructions allowed on two
+/// threads, and not allowed on one and on two, are the same bytes, `lines` lines (dumped in a
+/// scratch folder named `name`).
+fn assert_same_state_with_and_without_vector_instructions(name: &str, args: &[&str], lines: usize) {
     let dir = temp_dir(name);
     let mut dumps = Vec::new();
     for (vector, threads) in [("on", "2"), ("off", "1"), ("off", "2")] {
@@ -229,7 +226,12 @@ fn dumps_with_and_without_vector_instructions(
         lines,
         "a count line and the circles"
     );
-    dumps
+    for (k, dump) in dumps.iter().enumerate().skip(1) {
+        assert!(
+            *dump == dumps[0],
+            "{name}: run {k} differs from the vector run"
+        );
+    }
 }
 
 #[test]
@@ -243,10 +245,7 @@ fn the_contact_solver_gives_the_same_state_with_and_without_vector_instructions(
         "--steps",
         "120",
     ];
-    let dumps = dumps_with_and_without_vector_instructions("vector-soft", &args, 211);
-    for (k, dump) in dumps.iter().enumerate().skip(1) {
-        assert!(*dump == dumps[0], "run {k} differs from the vector run");
-    }
+    assert_same_state_with_and_without_vector_instructions("vector-soft", &args, 211);
 }
 
 #[test]
@@ -261,10 +260,7 @@ fn the_event_engine_gives_the_same_state_with_and_without_vector_instructions() 
         "--steps",
         "40",
     ];
-    let dumps = dumps_with_and_without_vector_instructions("vector-exact", &args, 4097);
-    for (k, dump) in dumps.iter().enumerate().skip(1) {
-        assert!(*dump == dumps[0], "run {k} differs from the vector run");
-    }
+    assert_same_state_with_and_without_vector_instructions("vector-exact", &args, 4097);
 }
 
 #[test]
