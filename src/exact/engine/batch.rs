@@ -2,8 +2,9 @@
 //! the cells list them, a batch at a time, then their pair times are worked out four at a time
 //! (one register per quantity) and the soonest kept in the order they were found. Each
 //! operation is the one [`EventEngine::look_at`] does for one pair (no fused multiply-add; its
-//! branches as masks), so the two give the same bits: the engine takes this path where the
-//! processor has AVX2 and [`crate::vector::allow`] lets it, and `look_at` one by one elsewhere.
+//! branches as masks), so the two give the same bits: a full prediction takes this path where
+//! the processor has AVX2 and [`crate::vector::allow`] lets it, and `look_at` one by one
+//! elsewhere (as does a crossing's look at the three cells it newly borders, cheaper so).
 //! Rounding half away from zero, as `f64::round`, is the truncation plus one more where the
 //! part cut off is half or more (both exact).
 
