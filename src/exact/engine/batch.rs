@@ -2,9 +2,11 @@
 //! the cells list them, a batch at a time, then their pair times are worked out four at a time
 //! (one register per quantity) and the soonest kept in the order they were found. Each
 //! operation is the one [`EventEngine::look_at`] does for one pair (no fused multiply-add; its
-//! branches as masks), so the two give the same bits: a full prediction takes this path where
-//! the processor has AVX2 and [`crate::vector::allow`] lets it, and `look_at` one by one
-//! elsewhere (as does a crossing's look at the three cells it newly borders, cheaper so).
+//! branches as masks), so the two give the same bits. A small circle's full prediction takes
+//! this path when circles fly straight lines (no gravity), radii do not grow and a pair is
+//! looked at through its nearest image only, where the processor has AVX2 and
+//! [`crate::vector::allow`] lets it; `look_at` one by one elsewhere (and for a crossing's look
+//! at the three cells it newly borders, cheaper so, and a large circle's look).
 //! Rounding half away from zero, as `f64::round`, is the truncation plus one more where the
 //! part cut off is half or more (both exact).
 
@@ -150,7 +152,9 @@ fn times(me: &Motion, frame: Frame, batch: &mut Batch, len: usize) {
             load(&batch.vy),
         );
         let (ot, or) = (load(&batch.t_at), load(&batch.radius));
-        let since = _mm256_max_pd(mt, ot);
+        // `a.max(b)` is `b` where `b > a`, else `a`; `_mm256_max_pd(b, a)` the same, to the
+        // zero's sign when the two are equal.
+        let since = _mm256_max_pd(ot, mt);
         // `other.at(since) - me.at(since)`, axis by axis.
         let at = |p, v, t| _mm256_add_pd(p, _mm256_mul_pd(v, _mm256_sub_pd(since, t)));
         let mut dpx = _mm256_sub_pd(at(ox, ovx, ot), at(mx, mvx, mt));
@@ -195,7 +199,7 @@ fn times(me: &Motion, frame: Frame, batch: &mut Batch, len: usize) {
         let valid = _mm256_and_pd(closing, _mm256_or_pd(touching, meets));
         // `t.max(0.0)`: `t` is not below +0 here (`c > 0`, `-b > 0`).
         let t = _mm256_blendv_pd(t, zero, touching);
-        let time = _mm256_max_pd(_mm256_add_pd(since, t), now);
+        let time = _mm256_max_pd(now, _mm256_add_pd(since, t));
         let time = _mm256_blendv_pd(infinity, time, valid);
         let four = &mut batch.time[k..k + 4];
         // SAFETY: `four` has room for the four f64 the store writes.
@@ -256,9 +260,10 @@ mod tests {
                 radius,
             });
         }
-        // The first at rest at (0, ¼) now; every fifth exactly (n + ½) periods from it along x,
-        // flying along x, its reference time now too: a rounding tie that decides whether they
-        // meet, as `f64::round` takes it away from zero and the other way would not.
+        // The first at rest at (0, ¼) now; every fifth exactly ±1½ or ±2½ periods from it along
+        // x (past half a period, so rounded), flying along x, its reference time now too: a
+        // rounding tie that decides whether they meet, as `f64::round` takes ±2½ away from zero
+        // and ties to even would not.
         motions[0] = Motion {
             pos: DVec2::new(0.0, 0.25),
             vel: DVec2::ZERO,
@@ -266,7 +271,7 @@ mod tests {
             radius: 0.1,
         };
         for k in (5..400).step_by(5) {
-            let n = rng.random_range(-3..3) as f64;
+            let n = [-3.0, -2.0, 1.0, 2.0][rng.random_range(0..4)];
             motions[k].pos = DVec2::new((n + 0.5) * period, 0.25);
             motions[k].vel = DVec2::new(if k % 10 == 0 { 1.0 } else { -1.0 }, 0.0);
             motions[k].t_at = 2.0;

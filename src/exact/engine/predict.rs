@@ -38,10 +38,10 @@ impl EventEngine {
         }
     }
 
-    /// [`EventEngine::scan`] over a whole block of cells: for circles on straight lines through
-    /// the nearest image, where the processor has AVX2, four pairs at a time
-    /// ([`super::batch`]; a few neighbours, as in the cells a crossing newly borders, are
-    /// cheaper one by one).
+    /// [`EventEngine::scan`] over a whole block of cells: for circles on straight lines with
+    /// radii that do not grow, through the nearest image, where the processor has AVX2 and
+    /// [`crate::vector::allow`] lets it, four pairs at a time ([`super::batch`]; a few
+    /// neighbours, as in the cells a crossing newly borders, are cheaper one by one).
     fn scan_block(&mut self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
         #[cfg(target_arch = "x86_64")]
         if self.gravity == DVec2::ZERO
