@@ -80,8 +80,8 @@ pub struct RunOptions {
     pub dump: Option<PathBuf>,
     /// Threads of the parallel parts of a step (results do not depend on it).
     pub threads: Option<u16>,
-    /// Whether the contact solver may use the processor's vector instructions (results do not
-    /// depend on it).
+    /// Whether the kernels may use the processor's vector instructions (results do not depend
+    /// on it).
     pub vector: bool,
     /// Where checkpoints go: at the end, when interrupted, and every `every` steps.
     pub checkpoint: Option<PathBuf>,

@@ -77,11 +77,7 @@ impl EventEngine {
         cells: impl IntoIterator<Item = usize>,
         batch: &mut Batch,
     ) -> BestPair {
-        let me = self.motion[i];
-        let frame = Frame {
-            now: self.now,
-            period: self.grid.periodic.then_some(self.period),
-        };
+        let (me, frame) = (self.motion[i], self.frame());
         let settle = |batch: &mut Batch, len: usize, best: &mut BestPair| {
             // SAFETY: the processor has AVX2, as the caller promises.
             unsafe { times(&me, frame, batch, len) };
@@ -232,7 +228,6 @@ mod tests {
     use super::*;
     use crate::arena::{Arena, Boundary};
     use crate::circle::CircleState;
-    use crate::exact::engine::events::nearest_image;
 
     /// Motions that try the kernel's every branch: pairs closing, parting, missing, touching
     /// and overlapping, at rest against each other, references times apart, displacements of
@@ -296,10 +291,7 @@ mod tests {
             let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
             engine.motion = hard_motions(&mut rng, 1.0);
             engine.now = 2.0;
-            let frame = Frame {
-                now: engine.now,
-                period: engine.grid.periodic.then_some(engine.period),
-            };
+            let frame = engine.frame();
             let mut batch = Batch::default();
             let (mut met, mut tested) = (0, 0);
             for i in 0..40 {
@@ -313,7 +305,7 @@ mod tests {
                     unsafe { times(&me, frame, &mut batch, others.len()) };
                     for (k, &j) in others.iter().enumerate() {
                         let mut alone = NO_PAIR;
-                        let nearest = |d| nearest_image(d, frame.period);
+                        let nearest = |d| engine.nearest_image(d);
                         engine.look_at::<false>(&me, j, nearest, &mut alone);
                         let (wide, one) = (batch.time[k], alone.time);
                         assert!(

@@ -92,23 +92,6 @@ pub(super) fn relative(
     (since, dp, dv)
 }
 
-/// How many whole periods along each axis the displacement `d` is beyond its minimum image
-/// (`d` minus that many periods is within half a period); none when the arena does not wrap.
-#[inline]
-pub(super) fn nearest_image(d: DVec2, period: Option<DVec2>) -> DVec2 {
-    let Some(period) = period else {
-        return DVec2::ZERO;
-    };
-    let whole = |d: f64, period: f64| {
-        if d.abs() > 0.5 * period {
-            (d / period).round()
-        } else {
-            0.0
-        }
-    };
-    DVec2::new(whole(d.x, period.x), whole(d.y, period.y))
-}
-
 /// The soonest pair collision a circle's last look at its neighbours found.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub(super) struct BestPair {
