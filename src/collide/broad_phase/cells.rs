@@ -3,7 +3,7 @@
 //! [`CellList::order`].
 
 use bevy::math::DVec2;
-use bevy::tasks::{ComputeTaskPool, ParallelSliceMut, TaskPool};
+use bevy::tasks::{ComputeTaskPool, ParallelSlice, ParallelSliceMut, TaskPool};
 
 use crate::grid::Grid;
 
@@ -31,13 +31,16 @@ impl CellList {
     /// memory).
     pub fn rebuild(&mut self, circles: &[(DVec2, f64)], min_cell: f64) {
         let n = circles.len();
-        let (lo, hi) = circles
-            .iter()
-            .map(|c| c.0)
-            .filter(|p| p.is_finite())
-            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p), hi.max(p))
-            });
+        let (lo, hi) = fold_chunks(
+            circles,
+            |chunk| {
+                let finite = chunk.iter().map(|c| c.0).filter(|p| p.is_finite());
+                finite.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p), hi.max(p))
+                })
+            },
+            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+        );
         let extent = if lo.x <= hi.x { hi - lo } else { DVec2::ZERO };
         let max_cells = (4 * n).max(1) as f64;
         let mut cell = min_cell.max(f64::MIN_POSITIVE);
@@ -94,7 +97,7 @@ impl CellList {
     fn fill(&mut self, circles: &[(DVec2, f64)]) {
         let cells = self.grid.len();
         let mut cell_of = std::mem::take(&mut self.cell_of);
-        cell_of.clear();
+        // Every element is written below: no clearing (at a million circles, a pass of its own).
         cell_of.resize(circles.len(), NO_CELL);
         let grid = self.grid;
         map_chunks(&mut cell_of, |from, out| {
@@ -119,7 +122,7 @@ impl CellList {
             self.start[c + 1] += self.start[c];
         }
         let placed = self.start[cells] as usize;
-        self.order.clear();
+        // Each place is written once below: no clearing.
         self.order.resize(placed, 0);
         // `start[c + 1]` is where cell `c` ends: filled from the back, each cell's circles end
         // up in input order and `start[c + 1]` where the cell begins, one place late (so no
@@ -198,17 +201,45 @@ impl CellList {
     }
 }
 
-/// The smallest and largest reach (`(∞, 0)` for no circles), in one pass.
+/// The smallest and largest reach (`(∞, 0)` for no circles), in one pass (on all cores for
+/// many circles).
 pub fn radius_range(circles: &[(DVec2, f64)]) -> (f64, f64) {
-    circles.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
-        (lo.min(c.1), hi.max(c.1))
-    })
+    fold_chunks(
+        circles,
+        |chunk| {
+            chunk.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
+                (lo.min(c.1), hi.max(c.1))
+            })
+        },
+        |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+    )
+}
+
+/// Chunk length of [`map_chunks`] and [`fold_chunks`]: fixed, so that how a long input is
+/// split does not depend on the threads.
+const CHUNK: usize = 1 << 14;
+
+/// `fold` over `items`: over chunks of it on all cores when it is long, the chunks' values
+/// joined in order with `join` (the same chunks and order whatever the number of threads).
+fn fold_chunks<T: Sync, A: Send + 'static>(
+    items: &[T],
+    fold: impl Fn(&[T]) -> A + Send + Sync,
+    join: impl Fn(A, A) -> A,
+) -> A {
+    // One chunk's fold is the whole fold.
+    if items.len() < PARALLEL_FROM || items.len() <= CHUNK {
+        return fold(items);
+    }
+    let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+    let chunks = items.par_chunk_map(pool, CHUNK, |_, chunk| fold(chunk));
+    let mut chunks = chunks.into_iter();
+    let first = chunks.next().expect("a long input has a first chunk");
+    chunks.fold(first, join)
 }
 
 /// Fills `out` by calling `fill(offset, chunk)` on chunks of it, on all cores when it is long
 /// (each element depends only on its index, so the result does not depend on the threads).
 pub(super) fn map_chunks<T: Send>(mut out: &mut [T], fill: impl Fn(usize, &mut [T]) + Send + Sync) {
-    const CHUNK: usize = 1 << 14;
     if out.len() < PARALLEL_FROM {
         fill(0, out);
         return;

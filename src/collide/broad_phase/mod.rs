@@ -311,4 +311,42 @@ mod tests {
         );
         assert_eq!(pairs, vec![(0, 2)]);
     }
+
+    #[test]
+    fn a_cell_list_used_again_forgets_the_last_circles() {
+        // The cell list keeps its tables from one rebuild to the next without clearing them:
+        // growing, shrinking, and with circles that take part in nothing (non-finite), each
+        // rebuild finds what a new list finds. Sizes past one chunk of the parallel folds.
+        let mut rng = ChaCha8Rng::seed_from_u64(13);
+        let mut kept = CellList::default();
+        for (n, spread) in [(40_000, 250.0), (600, 30.0), (50_000, 20.0), (9_000, 120.0)] {
+            let mut circles: Vec<(DVec2, f64)> = (0..n)
+                .map(|_| {
+                    let p =
+                        DVec2::new(rng.random_range(0.0..spread), rng.random_range(0.0..spread));
+                    (p, rng.random_range(0.05..0.6))
+                })
+                .collect();
+            for i in (0..n).step_by(97) {
+                circles[i].0.x = f64::NAN;
+            }
+            let serial = circles.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
+                (lo.min(c.1), hi.max(c.1))
+            });
+            assert_eq!(radius_range(&circles), serial, "n = {n}");
+            for arena in [
+                Arena::default(),
+                periodic_arena(DVec2::ZERO, DVec2::splat(spread)),
+            ] {
+                let (mut again, mut new) = (Vec::new(), Vec::new());
+                let mut fresh = CellList::default();
+                overlapping_pairs(&mut kept, &arena, &circles, &mut again);
+                overlapping_pairs(&mut fresh, &arena, &circles, &mut new);
+                assert!(!new.is_empty(), "n = {n}");
+                assert_eq!(again, new, "n = {n}, {arena:?}");
+                assert_eq!(kept.order(), fresh.order(), "n = {n}, {arena:?}");
+                assert_eq!(kept.sorted, fresh.sorted, "n = {n}, {arena:?}");
+            }
+        }
+    }
 }
