@@ -97,7 +97,8 @@ impl CellList {
     fn fill(&mut self, circles: &[(DVec2, f64)]) {
         let cells = self.grid.len();
         let mut cell_of = std::mem::take(&mut self.cell_of);
-        // Every element is written below: no clearing (at a million circles, a pass of its own).
+        // Resized, not refilled: every element is written below (at a million circles,
+        // writing them all first was a pass of its own).
         cell_of.resize(circles.len(), NO_CELL);
         let grid = self.grid;
         map_chunks(&mut cell_of, |from, out| {
@@ -122,7 +123,7 @@ impl CellList {
             self.start[c + 1] += self.start[c];
         }
         let placed = self.start[cells] as usize;
-        // Each place is written once below: no clearing.
+        // Resized, not refilled: each place is written once below.
         self.order.resize(placed, 0);
         // `start[c + 1]` is where cell `c` ends: filled from the back, each cell's circles end
         // up in input order and `start[c + 1]` where the cell begins, one place late (so no
@@ -219,15 +220,16 @@ pub fn radius_range(circles: &[(DVec2, f64)]) -> (f64, f64) {
 /// split does not depend on the threads.
 const CHUNK: usize = 1 << 14;
 
-/// `fold` over `items`: over chunks of it on all cores when it is long, the chunks' values
-/// joined in order with `join` (the same chunks and order whatever the number of threads).
+/// `fold` over `items`: over chunks of it on all cores when it is longer than one chunk, the
+/// chunks' values joined in order with `join` (the same chunks and order whatever the number of
+/// threads).
 fn fold_chunks<T: Sync, A: Send + 'static>(
     items: &[T],
     fold: impl Fn(&[T]) -> A + Send + Sync,
     join: impl Fn(A, A) -> A,
 ) -> A {
     // One chunk's fold is the whole fold.
-    if items.len() < PARALLEL_FROM || items.len() <= CHUNK {
+    if items.len() <= CHUNK {
         return fold(items);
     }
     let pool = ComputeTaskPool::get_or_init(TaskPool::default);

@@ -314,17 +314,24 @@ mod tests {
 
     #[test]
     fn a_cell_list_used_again_forgets_the_last_circles() {
-        // The cell list keeps its tables from one rebuild to the next without clearing them:
-        // growing, shrinking, and with circles that take part in nothing (non-finite), each
-        // rebuild finds what a new list finds. Sizes past one chunk of the parallel folds.
+        // The cell list keeps its tables from one rebuild to the next without refilling them:
+        // shrinking, growing, the same count on another grid, and with circles that take part
+        // in nothing (non-finite), each rebuild finds what a new list finds. Radii within a
+        // factor of 2, so one grid (the kept list) does the work; the two larger inputs are
+        // longer than one chunk of the parallel folds.
         let mut rng = ChaCha8Rng::seed_from_u64(13);
         let mut kept = CellList::default();
-        for (n, spread) in [(40_000, 250.0), (600, 30.0), (50_000, 20.0), (9_000, 120.0)] {
+        for (n, spread) in [
+            (40_000, 250.0),
+            (600, 30.0),
+            (50_000, 150.0),
+            (9_000, 120.0),
+        ] {
             let mut circles: Vec<(DVec2, f64)> = (0..n)
                 .map(|_| {
                     let p =
                         DVec2::new(rng.random_range(0.0..spread), rng.random_range(0.0..spread));
-                    (p, rng.random_range(0.05..0.6))
+                    (p, rng.random_range(0.3..0.6))
                 })
                 .collect();
             for i in (0..n).step_by(97) {
@@ -344,8 +351,10 @@ mod tests {
                 overlapping_pairs(&mut fresh, &arena, &circles, &mut new);
                 assert!(!new.is_empty(), "n = {n}");
                 assert_eq!(again, new, "n = {n}, {arena:?}");
+                assert_eq!(kept.order().len(), n - n.div_ceil(97), "n = {n}");
                 assert_eq!(kept.order(), fresh.order(), "n = {n}, {arena:?}");
                 assert_eq!(kept.sorted, fresh.sorted, "n = {n}, {arena:?}");
+                assert_eq!(kept.grid(), fresh.grid(), "n = {n}, {arena:?}");
             }
         }
     }

@@ -70,7 +70,7 @@ fn bin_in_cell_order(
     } else {
         cells.rebuild(circles, 2.0 * max_radius);
     }
-    // Every place is written below: no clearing.
+    // Resized, not refilled: every place is written below.
     sorted.resize(cells.order.len(), (DVec2::ZERO, 0.0));
     map_chunks(sorted, |from, out| {
         for (slot, &i) in out.iter_mut().zip(&cells.order[from..]) {
