@@ -107,8 +107,15 @@ impl Grid {
         let (cols, rows) = (self.cols as i64, self.rows as i64);
         let (mut x, mut y) = (x as i64 + dx, y as i64 + dy);
         if self.periodic {
-            x = x.rem_euclid(cols);
-            y = y.rem_euclid(rows);
+            // Most neighbours are inside the grid: no division for them.
+            let wrap = |v: i64, n: i64| {
+                if (0..n).contains(&v) {
+                    v
+                } else {
+                    v.rem_euclid(n)
+                }
+            };
+            (x, y) = (wrap(x, cols), wrap(y, rows));
         } else if x < 0 || y < 0 || x >= cols || y >= rows {
             return None;
         }

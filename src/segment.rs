@@ -242,6 +242,10 @@ impl SegmentCells {
     /// The segments listed in cell `c`.
     #[inline]
     pub fn in_cell(&self, c: usize) -> &[u32] {
+        if self.members.is_empty() {
+            // No segment: nothing to look up (the event engine asks at every event).
+            return &[];
+        }
         match self.start.get(c..c + 2) {
             Some(&[from, to]) => &self.members[from as usize..to as usize],
             _ => &[],

@@ -407,10 +407,12 @@ impl EventEngine {
         } else {
             (self.grid.rows as u32, &mut self.cell_y[i])
         };
-        *cell = if up {
-            (*cell + 1) % count
-        } else {
-            (*cell + count - 1) % count
+        // The next cell, wrapping past a periodic edge (no division: a crossing is frequent).
+        *cell = match (up, *cell) {
+            (true, c) if c + 1 == count => 0,
+            (true, c) => c + 1,
+            (false, 0) => count - 1,
+            (false, c) => c - 1,
         };
         if listed {
             self.cells.insert(i, self.cell_index(i));
