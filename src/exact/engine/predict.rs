@@ -200,9 +200,18 @@ impl EventEngine {
         self.best_pair[i] = if (1..cols - 1).contains(&x) && (1..rows - 1).contains(&y) {
             // Away from the edges: nine distinct cells, no wrapping.
             let c = self.cell_index(i);
-            let block = [c - cols, c, c + cols]
-                .into_iter()
-                .flat_map(|middle| [middle - 1, middle, middle + 1]);
+            let (below, above) = (c - cols, c + cols);
+            let block = [
+                below - 1,
+                below,
+                below + 1,
+                c - 1,
+                c,
+                c + 1,
+                above - 1,
+                above,
+                above + 1,
+            ];
             self.scan_block(i, block)
         } else {
             let (cells, len) = self.grid.block(x, y);
@@ -222,16 +231,28 @@ impl EventEngine {
         }
         let best = self.best_pair[i];
         let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
-        let ahead = if up { 1 } else { -1 };
-        let cells = (-1..=1).filter_map(|side| {
-            let (dx, dy) = if axis == 0 {
-                (ahead, side)
+        let (cols, rows) = (self.grid.cols, self.grid.rows);
+        let found = if (1..cols - 1).contains(&x) && (1..rows - 1).contains(&y) {
+            // Away from the edges: the three cells as plain indices, no wrapping.
+            let (step, side) = if axis == 0 { (1, cols) } else { (cols, 1) };
+            let middle = if up {
+                self.cell_index(i) + step
             } else {
-                (side, ahead)
+                self.cell_index(i) - step
             };
-            self.grid.neighbour(x, y, dx, dy)
-        });
-        let found = self.scan(i, cells);
+            self.scan(i, [middle - side, middle, middle + side])
+        } else {
+            let ahead = if up { 1 } else { -1 };
+            let cells = (-1..=1).filter_map(|side| {
+                let (dx, dy) = if axis == 0 {
+                    (ahead, side)
+                } else {
+                    (side, ahead)
+                };
+                self.grid.neighbour(x, y, dx, dy)
+            });
+            self.scan(i, cells)
+        };
         if found.time < best.time {
             self.best_pair[i] = found;
         }
