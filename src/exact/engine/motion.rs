@@ -1,11 +1,13 @@
 //! Where a circle is on its course: in a straight line, or on a parabola when it falls, from
 //! its reference point (`pos_at`, `vel_at`), moved there only where its course changes
-//! (`advance_circle`); and the fallback that moves every circle along its course without
-//! events when a step's budget runs out (`drift_to`).
+//! (`advance_circle`); the image of the periodic arena a displacement is nearest in; and the
+//! fallback that moves every circle along its course without events when a step's budget runs
+//! out (`drift_to`).
 
 use bevy::math::DVec2;
 
 use super::EventEngine;
+use super::events::Frame;
 use crate::arena::minimum_image;
 use crate::boundary::reflect_off_walls;
 
@@ -105,4 +107,38 @@ impl EventEngine {
             b - a
         }
     }
+
+    /// How many whole periods along each axis the displacement `d` is beyond its minimum image
+    /// (`d` minus that many periods is within half a period).
+    #[inline]
+    pub(super) fn nearest_image(&self, d: DVec2) -> DVec2 {
+        let period = self.period;
+        DVec2::new(whole_images(d.x, period.x), whole_images(d.y, period.y))
+    }
+
+    /// What a pair's time is worked out in: now, and the period when the arena wraps.
+    #[inline]
+    pub(super) fn frame(&self) -> Frame {
+        Frame {
+            now: self.now,
+            period: self.grid.periodic.then_some(self.period),
+        }
+    }
+}
+
+/// How many whole periods `d` is beyond its minimum image (`d` minus that many periods is
+/// within half a period).
+#[inline]
+fn whole_images(d: f64, period: f64) -> f64 {
+    if d.abs() > 0.5 * period {
+        (d / period).round()
+    } else {
+        0.0
+    }
+}
+
+/// The whole periods in `d` beyond its minimum image, as a length.
+#[inline]
+pub(super) fn whole_periods(d: f64, period: f64) -> f64 {
+    period * whole_images(d, period)
 }

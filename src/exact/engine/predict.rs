@@ -18,7 +18,8 @@
 use bevy::math::DVec2;
 
 use super::EventEngine;
-use super::events::{BestPair, Event, Frame, Kind, Motion, NO_PAIR, relative};
+use super::events::{BestPair, Event, Kind, Motion, NO_PAIR, relative};
+use super::motion::whole_periods;
 use crate::exact::fall::{exit_time, falling_pair_time, falling_segment_time};
 use crate::exact::toi::{
     growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact, wall_time_of_impact,
@@ -420,40 +421,4 @@ impl EventEngine {
         }
         true
     }
-}
-
-impl EventEngine {
-    /// How many whole periods along each axis the displacement `d` is beyond its minimum image
-    /// (`d` minus that many periods is within half a period).
-    #[inline]
-    pub(super) fn nearest_image(&self, d: DVec2) -> DVec2 {
-        let period = self.period;
-        DVec2::new(whole_images(d.x, period.x), whole_images(d.y, period.y))
-    }
-
-    /// What a pair's time is worked out in: now, and the period when the arena wraps.
-    #[inline]
-    pub(super) fn frame(&self) -> Frame {
-        Frame {
-            now: self.now,
-            period: self.grid.periodic.then_some(self.period),
-        }
-    }
-}
-
-/// How many whole periods `d` is beyond its minimum image (`d` minus that many periods is
-/// within half a period).
-#[inline]
-fn whole_images(d: f64, period: f64) -> f64 {
-    if d.abs() > 0.5 * period {
-        (d / period).round()
-    } else {
-        0.0
-    }
-}
-
-/// The whole periods in `d` beyond its minimum image, as a length.
-#[inline]
-fn whole_periods(d: f64, period: f64) -> f64 {
-    period * whole_images(d, period)
 }
