@@ -151,6 +151,74 @@ impl Grid {
         (cells, len)
     }
 
+    /// [`Grid::block`] where the block lies inside the grid, nothing clipped or wrapped: its nine
+    /// cells as plain indices in the same order, for the event engine's hottest loop. `None`
+    /// near the edges.
+    #[inline]
+    pub fn inner_block(&self, x: usize, y: usize) -> Option<[usize; 9]> {
+        if !self.is_inner(x, y) {
+            return None;
+        }
+        let c = self.index(x, y);
+        let (below, above) = (c - self.cols, c + self.cols);
+        Some([
+            below - 1,
+            below,
+            below + 1,
+            c - 1,
+            c,
+            c + 1,
+            above - 1,
+            above,
+            above + 1,
+        ])
+    }
+
+    /// The three cells beside `(x, y)` on its side `up` (or down) along `axis`, from −1 to +1
+    /// along the other axis: what a circle newly borders after crossing into `(x, y)`. Wrapped
+    /// on a periodic grid, fewer past the edge of a plain one.
+    #[inline]
+    pub fn ahead(
+        &self,
+        x: usize,
+        y: usize,
+        axis: usize,
+        up: bool,
+    ) -> impl Iterator<Item = usize> + '_ {
+        let ahead = if up { 1 } else { -1 };
+        (-1..=1).filter_map(move |side| {
+            let (dx, dy) = if axis == 0 {
+                (ahead, side)
+            } else {
+                (side, ahead)
+            };
+            self.neighbour(x, y, dx, dy)
+        })
+    }
+
+    /// [`Grid::ahead`] where those cells lie inside the grid: as plain indices in the same
+    /// order. `None` near the edges.
+    #[inline]
+    pub fn inner_ahead(&self, x: usize, y: usize, axis: usize, up: bool) -> Option<[usize; 3]> {
+        if !self.is_inner(x, y) {
+            return None;
+        }
+        let (step, side) = if axis == 0 {
+            (1, self.cols)
+        } else {
+            (self.cols, 1)
+        };
+        let c = self.index(x, y);
+        let middle = if up { c + step } else { c - step };
+        Some([middle - side, middle, middle + side])
+    }
+
+    /// Whether `(x, y)` has a cell on every side within the grid.
+    #[inline]
+    fn is_inner(&self, x: usize, y: usize) -> bool {
+        (1..self.cols - 1).contains(&x) && (1..self.rows - 1).contains(&y)
+    }
+
     /// The coordinate of the `k`-th cell boundary along `axis`.
     #[inline]
     pub fn edge(&self, axis: usize, k: usize) -> f64 {
@@ -299,6 +367,39 @@ mod tests {
         assert_eq!(&cells[..len], &[1, 0], "each cell once");
         assert_eq!(tiny.neighbour(0, 0, -1, 0), Some(1));
         assert_eq!(plain.neighbour(0, 0, -1, 0), None);
+    }
+
+    #[test]
+    fn inner_cells_are_the_plain_ones_in_the_same_order() {
+        // The event engine keeps the first of equally soon partners: the plain arrays must list
+        // the cells exactly as the general paths do, and be there for every inner cell.
+        for periodic in [false, true] {
+            for (cols, rows) in [(1, 1), (2, 3), (3, 3), (4, 6), (7, 5)] {
+                let mut grid = Grid::square(DVec2::ZERO, 1.0, cols, rows);
+                grid.periodic = periodic;
+                let (mut blocks, mut aheads) = (0, 0);
+                for (x, y) in (0..cols).flat_map(|x| (0..rows).map(move |y| (x, y))) {
+                    if let Some(inner) = grid.inner_block(x, y) {
+                        let (cells, len) = grid.block(x, y);
+                        assert_eq!(inner[..], cells[..len], "({x}, {y}) of {cols}×{rows}");
+                        blocks += 1;
+                    }
+                    for (axis, up) in [(0, false), (0, true), (1, false), (1, true)] {
+                        if let Some(inner) = grid.inner_ahead(x, y, axis, up) {
+                            let cells: Vec<usize> = grid.ahead(x, y, axis, up).collect();
+                            assert_eq!(
+                                inner[..],
+                                cells,
+                                "({x}, {y}) of {cols}×{rows}, {axis} {up}"
+                            );
+                            aheads += 1;
+                        }
+                    }
+                }
+                let inner = cols.saturating_sub(2) * rows.saturating_sub(2);
+                assert_eq!((blocks, aheads), (inner, 4 * inner), "{cols}×{rows}");
+            }
+        }
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! Where a circle is on its course: in a straight line, or on a parabola when it falls, from
 //! its reference point (`pos_at`, `vel_at`), moved there only where its course changes
-//! (`advance_circle`); the image of the periodic arena a displacement is nearest in; and the
-//! fallback that moves every circle along its course without events when a step's budget runs
-//! out (`drift_to`).
+//! (`advance_circle`); where a pair is across the periodic arena (the image a displacement is
+//! nearest in, and the `frame` of now and the period that a pair's time is worked out in); and
+//! the fallback that moves every circle along its course without events when a step's budget
+//! runs out (`drift_to`).
 
 use bevy::math::DVec2;
 

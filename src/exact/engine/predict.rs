@@ -197,26 +197,13 @@ impl EventEngine {
             return self.predict_large(i, reach);
         }
         let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
-        let (cols, rows) = (self.grid.cols, self.grid.rows);
-        self.best_pair[i] = if (1..cols - 1).contains(&x) && (1..rows - 1).contains(&y) {
-            // Away from the edges: nine distinct cells, no wrapping.
-            let c = self.cell_index(i);
-            let (below, above) = (c - cols, c + cols);
-            let block = [
-                below - 1,
-                below,
-                below + 1,
-                c - 1,
-                c,
-                c + 1,
-                above - 1,
-                above,
-                above + 1,
-            ];
-            self.scan_block(i, block)
-        } else {
-            let (cells, len) = self.grid.block(x, y);
-            self.scan_block(i, cells[..len].iter().copied())
+        self.best_pair[i] = match self.grid.inner_block(x, y) {
+            // Away from the edges: nine plain indices (an iterator costs a check at each cell).
+            Some(block) => self.scan_block(i, block),
+            None => {
+                let (cells, len) = self.grid.block(x, y);
+                self.scan_block(i, cells[..len].iter().copied())
+            }
         };
         self.schedule(i);
     }
@@ -232,27 +219,9 @@ impl EventEngine {
         }
         let best = self.best_pair[i];
         let (x, y) = (self.cell_x[i] as usize, self.cell_y[i] as usize);
-        let (cols, rows) = (self.grid.cols, self.grid.rows);
-        let found = if (1..cols - 1).contains(&x) && (1..rows - 1).contains(&y) {
-            // Away from the edges: the three cells as plain indices, no wrapping.
-            let (step, side) = if axis == 0 { (1, cols) } else { (cols, 1) };
-            let middle = if up {
-                self.cell_index(i) + step
-            } else {
-                self.cell_index(i) - step
-            };
-            self.scan(i, [middle - side, middle, middle + side])
-        } else {
-            let ahead = if up { 1 } else { -1 };
-            let cells = (-1..=1).filter_map(|side| {
-                let (dx, dy) = if axis == 0 {
-                    (ahead, side)
-                } else {
-                    (side, ahead)
-                };
-                self.grid.neighbour(x, y, dx, dy)
-            });
-            self.scan(i, cells)
+        let found = match self.grid.inner_ahead(x, y, axis, up) {
+            Some(cells) => self.scan(i, cells),
+            None => self.scan(i, self.grid.ahead(x, y, axis, up)),
         };
         if found.time < best.time {
             self.best_pair[i] = found;
