@@ -5,9 +5,10 @@
 # seconds, collisions per second and the compressibility factor Z. Each code looks at the whole
 # state every 10 time units: the peer writes its measurements (`write_interval 10`), ours ends a
 # step (`--dt 10`: every position written back to the world, the overlaps sampled). The
-# collisions and Z do not depend on the step.
+# collisions and Z do not depend on the step. OURS_DT sets another step for ours (OURS_DT=1 is
+# what this script ran before, and the peer recipe's own command).
 #
-# usage: benches/edmd_side_by_side.sh [ROUNDS]     (from the checkout; default 2 rounds)
+# usage: [OURS_DT=10] benches/edmd_side_by_side.sh [ROUNDS]   (from the checkout; default 2 rounds)
 #
 # Needs the peer built outside the project, as its recipe says:
 #   /tmp/edmd-peer/l09rin-EDMD/Cylinder2D/mdhdd
@@ -15,6 +16,7 @@
 set -euo pipefail
 
 rounds="${1:-2}"
+ours_dt="${OURS_DT:-10}"
 here="$(cd "$(dirname "$0")/.." && pwd)"
 shared="$(cd "$here/../shared" && pwd)"
 peer=/tmp/edmd-peer/l09rin-EDMD/Cylinder2D/mdhdd
@@ -54,7 +56,7 @@ EOF
 
     start=$(date +%s.%N)
     "$ours" run --particles "$shared/data/particles/hd10k-phi$phi.txt" --boundary periodic \
-      --solver exact --seconds "$time_units" --dt 10 --report "$work/ours-$phi.json" > /dev/null
+      --solver exact --seconds "$time_units" --dt "$ours_dt" --report "$work/ours-$phi.json" > /dev/null
     seconds=$(python3 -c "print($(date +%s.%N) - $start)")
     read -r collisions z < <(python3 -c "
 import json; r = json.load(open('$work/ours-$phi.json')); print(r['pair_collisions'], f\"{r['z']:.4f}\")")
