@@ -240,7 +240,7 @@ pub(crate) fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Vi
 
 /// Advances one fixed step with the current [`Solver`]: runs [`CircleStep`] once per substep
 /// with the substep's `dt`, or [`ContinuousStep`] or [`SoftStep`] once.
-fn run_circle_step(world: &mut World) {
+pub(crate) fn run_circle_step(world: &mut World) {
     let solver = *world.resource::<Solver>();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
     let whole_step = match solver {

@@ -19,7 +19,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::components::{Position, Velocity};
-use crate::schedule::CircleSystems;
+use crate::schedule::{CircleSystems, run_circle_step};
 
 /// How a circle's `Transform` follows its [`Position`] between fixed steps. As a component it
 /// chooses for one circle; circles without it follow [`DefaultSmoothing`].
@@ -91,7 +91,12 @@ impl Plugin for TransformSyncPlugin {
             .add_systems(
                 FixedUpdate,
                 (
-                    record_step_start.before(CircleSystems::Sleep),
+                    // In the step's own set, so after whatever a game orders before the
+                    // step (a teleport then is the step's start, not a slide from the old
+                    // place).
+                    record_step_start
+                        .in_set(CircleSystems::Step)
+                        .before(run_circle_step),
                     record_step_end.after(CircleSystems::Diagnostics),
                 ),
             )

@@ -26,7 +26,9 @@ pub mod segments;
 pub use segments::SegmentsPlugin;
 
 /// Keeps every circle inside the [`Arena`] by reflecting it off the walls, when the arena has
-/// walls. (The continuous solvers hit the walls inside their own step.)
+/// walls, under `discrete` and `substeps=N`. (`soft`, `swept` and `exact` hit the walls inside
+/// their own step, whether or not this plugin is in: an arena without walls is
+/// [`Boundary::Open`](crate::arena::Boundary::Open).)
 #[derive(Clone, Copy, Debug, Default)]
 pub struct WallsPlugin;
 

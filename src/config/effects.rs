@@ -16,7 +16,8 @@ use crate::range::{MAX_MAGNITUDE, check_vector};
 #[reflect(Resource, Debug)]
 #[serde(default, deny_unknown_fields)]
 pub struct Effects {
-    /// Circle-circle collisions (broad phase, separation and impulse).
+    /// Circle-circle collisions, under every solver. Off, circles pass through each other: the
+    /// time-stepped solvers schedule no broad phase, the event-driven ones predict no pair.
     pub collisions: bool,
     /// Constant acceleration, e.g. `(0, -9.81)`; `None` schedules no gravity system.
     pub gravity: Option<DVec2>,

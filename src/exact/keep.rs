@@ -12,7 +12,7 @@ use super::engine::{EngineSnapshot, EventEngine, EventStats, Rest, Roughness};
 use super::outside::{moved_since, turning_of};
 use crate::arena::Arena;
 use crate::circle::CircleState;
-use crate::collision_layers::CircleFilters;
+use crate::collision_layers::{CircleFilters, CollisionLayers};
 use crate::components::{
     AngularVelocity, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep, SolverCircles,
     SpinCircles, Velocity,
@@ -349,7 +349,12 @@ pub(super) fn gather_into_engine(
         }
     }
     let all = circles.p0();
-    let layers = own.filters.gather(entities.iter().copied());
+    // Without the collisions effect no pair meets: every circle's layers meet none, as a
+    // sensor's, so no circle looks for another (walls and segments still hold them).
+    let layers = match effects.collisions {
+        true => own.filters.gather(entities.iter().copied()),
+        false => vec![CollisionLayers::NONE; entities.len()],
+    };
     let restitutions = (effects.restitution, effects.wall_restitution);
     let fall = (effects.gravity, &rest[..]);
     let Some(mut engine) = EventEngine::build_until(

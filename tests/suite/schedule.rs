@@ -79,21 +79,35 @@ fn without_collisions_there_is_no_collision_system() {
         names.iter().any(|n| n.contains("integrate_positions")),
         "{names:#?}"
     );
-    // And the circles really pass through each other.
-    let mut app = create_app(CirclesConfig {
-        effects: Effects {
-            collisions: false,
-            ..default()
-        },
-        ..default()
-    });
-    spawn_head_on(&mut app, 1.0, 1.0, 0.5);
-    step(&mut app, 120);
-    let xs: Vec<f64> = circles(&mut app).iter().map(|c| c.0.x).collect();
-    assert!(
-        xs[0] > 0.0 && xs[1] < 0.0,
-        "without collisions the circles cross: {xs:?}"
-    );
+    // And under every solver the circles really pass through each other, where with
+    // collisions they bounce back.
+    let solvers = [
+        Solver::Discrete,
+        Solver::Substeps(4),
+        Solver::Soft(4),
+        Solver::Swept,
+        Solver::Exact,
+    ];
+    for solver in solvers {
+        for collisions in [false, true] {
+            let mut app = create_app(CirclesConfig {
+                solver,
+                effects: Effects {
+                    collisions,
+                    ..default()
+                },
+                ..default()
+            });
+            spawn_head_on(&mut app, 1.0, 1.0, 0.5);
+            step(&mut app, 120);
+            let xs: Vec<f64> = circles(&mut app).iter().map(|c| c.0.x).collect();
+            let crossed = xs[0] > 0.0 && xs[1] < 0.0;
+            assert_eq!(
+                crossed, !collisions,
+                "{solver:?}, collisions {collisions}: {xs:?}"
+            );
+        }
+    }
 }
 
 #[test]

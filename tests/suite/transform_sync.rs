@@ -171,6 +171,43 @@ fn a_teleport_is_shown_where_it_was_put_and_never_smeared() {
 }
 
 #[test]
+fn a_teleport_from_the_fixed_step_just_before_the_step_is_not_smeared() {
+    // A game system in `FixedUpdate` ordered only before the step (here also after the sleep
+    // set, as late as it can be): the step's start must be taken after it, or the step would
+    // be shown sliding from the old place.
+    for smoothing in [Smoothing::Interpolate, Smoothing::Extrapolate] {
+        for step in [40, 41, 42] {
+            let (mut app, id) = app(Some(smoothing));
+            let target = DVec2::new(6.0, -3.0);
+            app.insert_resource(TeleportAt(step, target)).add_systems(
+                FixedUpdate,
+                teleport
+                    .after(CircleSystems::Sleep)
+                    .before(CircleSystems::Step),
+            );
+            let teleported = |app: &App| app.world().resource::<TeleportAt>().0 > step;
+            let mut frame = 0;
+            while !teleported(&app) {
+                let before = shown(&app, id).truncate().as_dvec2();
+                assert!((before - target).length() > 1.0, "not there before");
+                app.update();
+                frame += 1;
+                assert!(frame < 200, "step {step} never came");
+            }
+            for after in 0..30 {
+                let at = shown(&app, id).truncate().as_dvec2();
+                assert!(
+                    (at - target).length() < 0.5,
+                    "{smoothing:?}, step {step}, frame {after} after the teleport: shown at \
+                     {at}, put at {target}"
+                );
+                app.update();
+            }
+        }
+    }
+}
+
+#[test]
 fn circles_without_a_transform_are_left_alone() {
     let (mut app, _) = app(None);
     let bare = app
