@@ -120,7 +120,7 @@ fn in_an_open_arena_segment_walls_hold_what_lands_on_them_and_the_rest_falls_awa
 
 #[test]
 fn a_checkpoint_with_circles_far_outside_an_open_arena_resumes_the_same() {
-    for solver in [Solver::Soft(4), Solver::Exact] {
+    for solver in EVERY_SOLVER {
         let config = open(solver, Some(DVec2::new(0.0, -9.81)), Vec::new());
         let mut app = create_app(config);
         for k in 0..6 {
