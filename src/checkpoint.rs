@@ -4,10 +4,9 @@
 //! on bit for bit as the run would have (a game whose circles gained components goes on from
 //! the same state, its circles perhaps in another query order: see `own`).
 //! Written by `run --checkpoint` through [`write_atomically`](crate::io::write_atomically) in
-//! a compact binary form (postcard); read back with a size limit and every value checked, so a
-//! damaged or forged file is an error naming the file, never a panic.
-
-use std::path::Path;
+//! a compact binary form (postcard) that ends in a checksum (`bytes`); read back with a size
+//! limit, the checksum and every value checked, so a damaged or forged file is an error naming
+//! the file, never a panic.
 
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -24,7 +23,6 @@ use crate::config::{
 use crate::error::InputError;
 use crate::exact::EngineState;
 use crate::exact::engine::EngineSnapshot;
-use crate::io::read_bytes_limited;
 use crate::range::check_mass;
 use crate::run::{Progress, headless_app};
 use crate::scene::check::check_motion;
@@ -33,10 +31,9 @@ use crate::segment::Segments;
 use crate::sleep::Sleeping;
 use crate::soft::{CacheSnapshot, SoftState};
 use crate::spawn::{Dropped, SpawnReport};
+use bytes::FORMAT;
 use own::OwnParts;
 
-/// The first field of every checkpoint: what it is and the layout's version.
-const FORMAT: &str = "moving_circles checkpoint 8";
 /// Most bytes a checkpoint may have: the most circles an input may ask for, each with its
 /// engine state, fit.
 pub const MAX_CHECKPOINT_BYTES: u64 = 2 << 30;
@@ -169,55 +166,6 @@ impl Checkpoint {
     /// The fixed step, in seconds.
     pub fn dt(&self) -> f64 {
         self.dt
-    }
-
-    /// The checkpoint as bytes.
-    pub fn to_bytes(&self) -> Vec<u8> {
-        postcard::to_stdvec(self).expect("a checkpoint is plain data")
-    }
-
-    /// Reads and checks a checkpoint file.
-    pub fn read(path: &Path) -> Result<Self, InputError> {
-        let origin = path.display().to_string();
-        let bytes = std::fs::File::open(path)
-            .and_then(|file| read_bytes_limited(file, MAX_CHECKPOINT_BYTES))
-            .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?
-            .ok_or_else(|| {
-                InputError::whole(
-                    &origin,
-                    format!(
-                        "larger than the {} GiB a checkpoint may have",
-                        MAX_CHECKPOINT_BYTES >> 30
-                    ),
-                )
-            })?;
-        Self::from_bytes(&bytes, &origin)
-    }
-
-    /// Reads and checks checkpoint bytes; `origin` names them in errors.
-    pub fn from_bytes(bytes: &[u8], origin: &str) -> Result<Self, InputError> {
-        let not_one = || InputError::whole(origin, "not a moving_circles checkpoint");
-        // The format string comes first: check it before decoding anything else.
-        let (format, _) = postcard::take_from_bytes::<String>(bytes).map_err(|_| not_one())?;
-        if format != FORMAT {
-            return Err(if format.starts_with("moving_circles checkpoint") {
-                InputError::whole(
-                    origin,
-                    format!(
-                        "written by another version ({}), this one reads `{FORMAT}`",
-                        crate::io::printable(&format)
-                    ),
-                )
-            } else {
-                not_one()
-            });
-        }
-        let checkpoint: Self = postcard::from_bytes(bytes)
-            .map_err(|e| InputError::whole(origin, format!("damaged checkpoint: {e}")))?;
-        checkpoint
-            .check()
-            .map_err(|message| InputError::whole(origin, message))?;
-        Ok(checkpoint)
     }
 
     /// Whether the settings and every value are usable (the settings through the same checks
@@ -410,6 +358,7 @@ impl Checkpoint {
     }
 }
 
+mod bytes;
 mod own;
 #[cfg(test)]
 mod tests;

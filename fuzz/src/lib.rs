@@ -116,15 +116,19 @@ pub fn simulate(data: &[u8]) {
     }
 }
 
-/// Any bytes as a checkpoint: refused with a clear one-line error, or accepted as one that is
-/// written back to bytes that are read back the same. An accepted checkpoint of at most
+/// Any bytes as a checkpoint, their checksum first made to match the rest
+/// ([`Checkpoint::reseal`]: a mutation would otherwise almost never get past it): refused with
+/// a clear one-line error, or accepted as one that is written back to bytes that are read back
+/// the same. An accepted checkpoint of at most
 /// [`MAX_SIMULATED_CIRCLES`] resumes or is refused the same way, and then runs
 /// [`SIMULATED_STEPS`] under its own solver with the promises of [`simulate`] (overlap only
 /// if it began with none, of circles or of segment walls: a checkpoint of a time-stepped run
 /// may hold overlaps, and an edit of the solver or a wall is not a damage the reader can see);
 /// the checkpoint of where it ends is read back.
 pub fn checkpoint(data: &[u8]) {
-    let checkpoint = match Checkpoint::from_bytes(data, ORIGIN) {
+    let mut data = data.to_vec();
+    Checkpoint::reseal(&mut data);
+    let checkpoint = match Checkpoint::from_bytes(&data, ORIGIN) {
         Ok(checkpoint) => checkpoint,
         Err(error) => {
             refused::<()>(&error);

@@ -1,8 +1,9 @@
-//! What the checkpoint reader refuses of a checkpoint we wrote, edited: an arena that no longer
-//! holds its circles, an impossible radius, a sleeper that moves or turns, a rotation out of
+//! What the checkpoint reader refuses of a checkpoint we wrote, edited: any byte changed, cut
+//! or added (the checksum), an arena that no longer holds its circles, an impossible radius, a sleeper that moves or turns, a rotation out of
 //! range, a clock that is not its steps, parts of their own out of range or order, first
 //! energies below zero or past the range.
 
+use super::bytes::CHECKSUM_BYTES;
 use super::*;
 use bevy::math::DVec2;
 
@@ -12,6 +13,62 @@ fn taken(app: &mut App) -> Checkpoint {
     let good = Checkpoint::take(app.world_mut(), "t", &progress);
     assert!(Checkpoint::from_bytes(&good.to_bytes(), "c").is_ok());
     good
+}
+
+#[test]
+fn every_byte_changed_cut_or_added_is_refused_as_damaged() {
+    let mut config = CirclesConfig::default();
+    config.spawn.count = 8;
+    config.solver = Solver::Exact;
+    let mut app = headless_app(config);
+    app.update();
+    let good = taken(&mut app).to_bytes();
+    let damaged = |bytes: &[u8], what: &str| {
+        let error = Checkpoint::from_bytes(bytes, "c")
+            .expect_err(what)
+            .to_string();
+        assert!(error.contains("damaged checkpoint"), "{what}: {error}");
+    };
+    // Past the format's name (a change there says what the file is instead): one bit of each
+    // byte, and a byte's every other value at a few places.
+    let header = 1 + FORMAT.len();
+    for at in header..good.len() {
+        let mut changed = good.clone();
+        changed[at] ^= 1 << (at % 8);
+        damaged(&changed, &format!("bit {} of byte {at} flipped", at % 8));
+    }
+    for at in [header, good.len() / 2, good.len() - 1] {
+        for value in 0..=255u8 {
+            if value != good[at] {
+                let mut changed = good.clone();
+                changed[at] = value;
+                damaged(&changed, &format!("byte {at} set to {value}"));
+            }
+        }
+    }
+    for cut in [
+        header,
+        good.len() / 2,
+        good.len() - CHECKSUM_BYTES,
+        good.len() - 1,
+    ] {
+        damaged(&good[..cut], &format!("cut to {cut} bytes"));
+    }
+    let mut longer = good.clone();
+    longer.push(0);
+    damaged(&longer, "a byte added");
+    // Resealed, a byte added before the checksum is still refused: it is past the last field.
+    let mut padded = good[..good.len() - CHECKSUM_BYTES].to_vec();
+    padded.extend_from_slice(&[0; 1 + CHECKSUM_BYTES]);
+    Checkpoint::reseal(&mut padded);
+    let error = Checkpoint::from_bytes(&padded, "c")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("1 byte past its last field"), "{error}");
+    // Resealing what we wrote changes nothing.
+    let mut resealed = good.clone();
+    Checkpoint::reseal(&mut resealed);
+    assert_eq!(resealed, good);
 }
 
 #[test]

@@ -116,32 +116,40 @@ fn a_checkpoint_that_is_damaged_or_not_one_is_refused_by_name() {
     let mut flipped = good.clone();
     let last = flipped.len() - 9;
     flipped[last] ^= 0x40;
+    let mut longer = good.clone();
+    longer.push(b'\n');
     // Everything after the format's name at its largest: every length and count it reads
     // claims more than memory holds.
     let header = b"\x1bmoving_circles checkpoint ".len() + 2;
     let mut largest = good.clone();
     largest[header..].fill(0xff);
-    let cases: [(&[u8], &str); 5] = [
+    // A bit flipped deep in a number, or a byte added, could still read as a usable state:
+    // the checksum refuses both.
+    let cases: [(&[u8], &str); 6] = [
         (b"", "not a moving_circles checkpoint"),
         (b"hello, world", "not a moving_circles checkpoint"),
         (&truncated, "damaged checkpoint"),
         (&largest, "damaged checkpoint"),
-        (&flipped, ""),
+        (&flipped, "damaged checkpoint"),
+        (&longer, "damaged checkpoint"),
     ];
-    for (bytes, expected) in cases {
-        std::fs::write(&checkpoint, bytes).unwrap();
+    let refused = |path: &str, expected: &str| {
         // Refused before allocating what it claims: within the memory bound.
-        let out = under_one_gib(&["run", "--resume", c, "--steps", "5"]);
+        let out = under_one_gib(&["run", "--resume", path, "--steps", "5"]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!stderr.contains("panicked"), "{stderr}");
-        if out.status.success() {
-            // A flipped bit deep in a number may still be a usable state; then it must run.
-            assert!(expected.is_empty(), "accepted: {stderr}");
-        } else {
-            assert_eq!(out.status.code(), Some(1), "{stderr}");
-            assert!(stderr.contains(c) && stderr.contains(expected), "{stderr}");
-        }
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains(path) && stderr.contains(expected),
+            "{stderr}"
+        );
+    };
+    for (bytes, expected) in cases {
+        std::fs::write(&checkpoint, bytes).unwrap();
+        refused(c, expected);
     }
+    // An endless device is refused at its first bytes, not read to the size limit first.
+    refused("/dev/zero", "not a moving_circles checkpoint");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
