@@ -308,7 +308,9 @@ fn a_state_past_the_range_of_values_is_not_written_as_what_our_readers_refuse() 
             "{written} was written"
         );
     }
-    // A checkpoint due every step is checked as our reader checks it, and not written either.
+    // A checkpoint due every step is not written either: the run stops at the first sample
+    // past the range, before the checkpoint of that step (which would be checked as our reader
+    // checks it, and refused).
     let out = crate::common::binary::moving_circles(&[
         "run",
         "--resume",
@@ -322,7 +324,47 @@ fn a_state_past_the_range_of_values_is_not_written_as_what_our_readers_refuse() 
     ]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let said = stderr(&out);
-    assert!(said.contains("our own reader would refuse it"), "{said}");
+    assert!(said.contains("left the range of values"), "{said}");
     assert!(!std::path::Path::new(&checkpoint).exists(), "written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_run_that_leaves_the_range_of_values_stops_at_the_first_sample_past_it() {
+    // Found trying the command as a user would: a pull and a drag of 10³⁰ take the circles
+    // past the range within a minute's step, and the run went on to its end (seconds a step
+    // at speeds past 10³⁰ under the event-driven solvers) only to write nothing. It stops at the sample that
+    // shows it, says which step, and writes nothing.
+    let dir = temp_dir("leaves-range");
+    let scene = dir.join("s.ron");
+    std::fs::write(
+        &scene,
+        "(effects: (gravity: (0.0, -1e30), drag: 1e30), spawn: (count: 50, seed: 2))",
+    )
+    .unwrap();
+    let report = dir.join("r.json");
+    let out = crate::common::binary::moving_circles(&[
+        "run",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--solver",
+        "swept",
+        "--dt",
+        "60",
+        "--steps",
+        "20",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let said = stderr(&out);
+    let step: u64 = said
+        .split("by step ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no step named: {said}"));
+    assert!(step <= 2, "ran on to step {step}: {said}");
+    assert!(!report.exists(), "written");
     std::fs::remove_dir_all(&dir).unwrap();
 }

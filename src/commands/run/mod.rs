@@ -94,6 +94,9 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     let sampling = default_sampling(app.world().resource::<crate::spawn::SpawnReport>().placed);
     // What could not be written; the other outputs are written all the same.
     let mut failed: Vec<anyhow::Error> = Vec::new();
+    // The first sample whose state has left the range of values: nothing of it will be
+    // written, and such a state only gets further, so the run stops there, not at its end.
+    let left_range = std::cell::Cell::new(None);
     let stopped = loop {
         let now = app.world().resource::<StepTotals>().steps;
         // Where the next checkpoint is due, or the end.
@@ -107,11 +110,17 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
         } else {
             due
         };
-        let stop = || interrupts.raised().is_some();
+        let stop = || interrupts.raised().is_some() || left_range.get().is_some();
         let before = progress.stepping;
         let stopped = advance(&mut app, &mut progress, next, sampling, stop, |s| {
-            bar.set_position(s.step - first)
+            bar.set_position(s.step - first);
+            if out_of_range(s.world).is_some() {
+                left_range.set(Some(s.step));
+            }
         });
+        if left_range.get().is_some() {
+            break false;
+        }
         if now == first && !stopped {
             say_if_slow(progress.stepping - before, until - first);
         }
@@ -146,9 +155,11 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     }
     if let Some((i, e)) = out_of_range(app.world_mut()) {
         let also: Vec<String> = failed.iter().map(|e| format!("; {e:#}")).collect();
+        let step = app.world().resource::<StepTotals>().steps;
         bail!(
-            "the run's state left the range of values a file may hold (circle {i}'s {e}); \
-             no output of it was written (checkpoints of earlier steps are kept){}",
+            "the run's state left the range of values a file may hold by step {step} (circle \
+             {i}'s {e}); the run stopped there and no output of it was written (checkpoints of \
+             earlier steps are kept){}",
             also.concat()
         );
     }
