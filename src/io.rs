@@ -58,6 +58,11 @@ impl<R: BufRead> Lines<R> {
         }
     }
 
+    /// The reader the lines come from.
+    pub fn get_ref(&self) -> &R {
+        &self.reader
+    }
+
     /// The next line, `None` at the end of the input.
     #[allow(clippy::should_implement_trait)]
     pub fn next(&mut self) -> Option<Result<(usize, &str), LineError>> {

@@ -209,7 +209,7 @@ fn read_back(bytes: &[u8], what: &str) {
 
 /// Reads `data` as a particle file and checks what came of it.
 fn read_particles(data: &[u8], boundary: Boundary) -> Option<Vec<CircleState>> {
-    let circles = match particle_file::parse_from(data, ORIGIN, boundary) {
+    let circles = match particle_file::parse_from(data, ORIGIN, boundary, || false) {
         Ok(circles) => circles,
         Err(error) => return refused(&error),
     };

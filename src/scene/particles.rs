@@ -23,27 +23,58 @@ pub const MAX_PARTICLE_BYTES: u64 = 4 << 30;
 /// Reads a particle file's text. `origin` names it in errors. Circles must lie inside the unit
 /// square (with walls: entirely; periodic: their centres) and must not overlap beyond rounding.
 pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleState>, InputError> {
-    parse_from(text.as_bytes(), origin, boundary)
+    parse_from(text.as_bytes(), origin, boundary, || false)
 }
 
 /// [`parse`] reading line by line from `reader`, at most [`MAX_PARTICLE_BYTES`] and lines of at
-/// most [`MAX_LINE_BYTES`](crate::io::MAX_LINE_BYTES): memory grows with the circles read, never with what the header
-/// claims or with a line that never ends.
+/// most [`MAX_LINE_BYTES`](crate::io::MAX_LINE_BYTES): memory grows with the circles read,
+/// never with what the header claims or with a line that never ends. Before each line it asks
+/// `stop` whether to give up (a signal: an endless stream of blank lines must not keep it).
 pub fn parse_from(
     reader: impl BufRead,
     origin: &str,
     boundary: Boundary,
+    stop: impl Fn() -> bool,
 ) -> Result<Vec<CircleState>, InputError> {
-    let mut lines = Lines::new(reader.take(MAX_PARTICLE_BYTES + 1));
+    parse_limited(reader, origin, boundary, stop, MAX_PARTICLE_BYTES)
+}
+
+/// [`parse_from`] with at most `limit` bytes.
+fn parse_limited(
+    reader: impl BufRead,
+    origin: &str,
+    boundary: Boundary,
+    stop: impl Fn() -> bool,
+    limit: u64,
+) -> Result<Vec<CircleState>, InputError> {
+    let mut lines = Lines::new(reader.take(limit + 1));
     let mut next_line = || -> Result<Option<(usize, String)>, InputError> {
         loop {
-            match lines.next() {
+            if stop() {
+                return Err(InputError::whole(origin, "reading interrupted"));
+            }
+            let line = lines
+                .next()
+                .map(|read| read.map(|(n, line)| (n, line.to_owned())));
+            // The bytes allowed and one more were read: the file is past the limit (its last
+            // line may be cut there, so this is said before that line is looked at).
+            if lines.get_ref().limit() == 0 {
+                let size = match limit % (1 << 30) {
+                    0 => format!("{} GiB", limit >> 30),
+                    _ => format!("{limit} bytes"),
+                };
+                return Err(InputError::whole(
+                    origin,
+                    format!("larger than the {size} a particle file may have"),
+                ));
+            }
+            match line {
                 None => return Ok(None),
                 Some(Err((number, message))) => {
                     return Err(InputError::line(origin, number, message));
                 }
-                Some(Ok((_, ""))) => continue,
-                Some(Ok((number, line))) => return Ok(Some((number, line.to_owned()))),
+                Some(Ok((_, line))) if line.is_empty() => continue,
+                Some(Ok(numbered)) => return Ok(Some(numbered)),
             }
         }
     };
@@ -150,10 +181,19 @@ fn parse_circle(line: &str) -> Result<CircleState, String> {
 
 /// Reads a particle file.
 pub fn read(path: &Path, boundary: Boundary) -> Result<Vec<CircleState>, InputError> {
+    read_until(path, boundary, || false)
+}
+
+/// [`read`], asking `stop` before each line whether to give up ([`parse_from`]).
+pub fn read_until(
+    path: &Path,
+    boundary: Boundary,
+    stop: impl Fn() -> bool,
+) -> Result<Vec<CircleState>, InputError> {
     let origin = path.display().to_string();
     let file = std::fs::File::open(path)
         .map_err(|e| InputError::whole(&origin, format!("cannot read: {e}")))?;
-    parse_from(std::io::BufReader::new(file), &origin, boundary)
+    parse_from(std::io::BufReader::new(file), &origin, boundary, stop)
 }
 
 /// The particle-format text of `circles`.
@@ -194,6 +234,42 @@ mod tests {
         assert_eq!(circles[1].mass, 2.5);
         assert_eq!(circles[0].tint, [255, 0, 10]);
         assert_eq!(format(&circles), text);
+    }
+
+    #[test]
+    fn a_file_past_the_size_limit_says_so_whatever_its_last_line() {
+        // Blank lines, a cut circle line, a whole one: past the limit the error is the limit.
+        let limit = 64;
+        for text in [
+            "\n".repeat(100),
+            format!("1\n{}0.5 0.5 0 0 0.01 1 0 0 0\n", " ".repeat(60)),
+            format!("1\n0.5 0.5 0 0 0.01 1 0 0 0\n{}", "\n".repeat(60)),
+        ] {
+            let error = parse_limited(text.as_bytes(), "f", Boundary::Walls, || false, limit)
+                .unwrap_err()
+                .to_string();
+            assert_eq!(
+                error,
+                "f: larger than the 64 bytes a particle file may have"
+            );
+        }
+        // At the limit exactly, it is read.
+        let whole = "1\n0.5 0.5 0 0 0.01 1 0 0 0\n";
+        let limit = whole.len() as u64;
+        assert!(parse_limited(whole.as_bytes(), "f", Boundary::Walls, || false, limit).is_ok());
+    }
+
+    #[test]
+    fn a_stop_request_ends_the_reading() {
+        let text = format!("2\n{}", "\n".repeat(1000));
+        let asked = std::cell::Cell::new(0);
+        let stop = || {
+            asked.set(asked.get() + 1);
+            asked.get() > 10
+        };
+        let error = parse_from(text.as_bytes(), "f", Boundary::Walls, stop).unwrap_err();
+        assert_eq!(error.to_string(), "f: reading interrupted");
+        assert_eq!(asked.get(), 11, "asked before each line");
     }
 
     fn error_of(text: &str) -> String {

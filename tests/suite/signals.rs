@@ -1,7 +1,8 @@
 //! Signals through the real binary: SIGINT or SIGTERM ends a run after a whole step with its
 //! report, final state and checkpoint written; a long event-driven step is cut short within a
-//! second of the signal; a signal while the circles are placed or compressed ends the run at
-//! once, writing nothing; and a second signal ends it at once without touching what was there.
+//! second of the signal; a signal while a particle file is read or the circles are placed or
+//! compressed ends the run at once, writing nothing; and a second signal ends it at once
+//! without touching what was there.
 #![cfg(unix)]
 
 use std::path::{Path, PathBuf};
@@ -226,5 +227,68 @@ fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
     );
     assert_eq!(text(&report), "old");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "a stray file");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_signal_while_a_particle_file_is_read_ends_the_run_and_writes_nothing() {
+    // A pipe of blank lines that never ends: the reader skips them one by one, within the
+    // size limit for a long while. A signal ends it there (the first signal only asks, so the
+    // reader must ask back).
+    let dir = temp_dir("reading");
+    let report = dir.join("r.json");
+    std::fs::write(&report, "old").unwrap();
+    let mut child = command(&[
+        "run",
+        "--particles",
+        "/dev/stdin",
+        "--steps",
+        "1",
+        "--report",
+        report.to_str().unwrap(),
+    ])
+    .stdin(Stdio::piped())
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let (read_tx, read_rx) = std::sync::mpsc::channel();
+    let feeder = std::thread::spawn(move || {
+        let blank = vec![b'\n'; 1 << 16];
+        let mut written = 0usize;
+        while std::io::Write::write_all(&mut stdin, &blank).is_ok() {
+            written += blank.len();
+            // Past what the pipe holds: the run is reading.
+            if written == 1 << 22 {
+                read_tx.send(()).unwrap();
+            }
+        }
+    });
+    read_rx
+        .recv_timeout(Duration::from_secs(60))
+        .expect("the run reads its input");
+    signal(&child, "TERM");
+    let sent = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if sent.elapsed() > Duration::from_secs(20) {
+            child.kill().unwrap();
+            panic!("the run went on reading after the signal");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    feeder.join().unwrap();
+    let mut stdout = String::new();
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
+    assert_eq!(status.code(), Some(143), "{stdout}");
+    assert!(stdout.contains("while reading the input"), "{stdout}");
+    assert_eq!(
+        text(&report),
+        "old",
+        "nothing was run, so nothing is replaced"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -55,7 +55,19 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             (app, progress, source, dt)
         }
         input => {
-            let (config, source) = configure(input, &options)?;
+            let raised = || interrupts.raised().is_some();
+            let (config, source) = match configure(input, &options, raised) {
+                Ok(loaded) => loaded,
+                // A signal while the input was read (a particle file is read line by line, and
+                // a pipe may never end): nothing was run, every output is left as it was.
+                Err(_) if let Some(signal) = interrupts.raised() => {
+                    say(format_args!(
+                        "interrupted by signal {signal} while reading the input; nothing written"
+                    ));
+                    return Ok(Finished::Interrupted { signal });
+                }
+                Err(e) => return Err(e),
+            };
             if config.effects.has_friction() && !matches!(config.solver, Solver::Soft(_)) {
                 let solver = config.solver;
                 say(format_args!(

@@ -25,8 +25,9 @@ const ANNOUNCE_PACK_FROM: usize = 20_000;
 pub(super) fn configure(
     input: &Input,
     options: &RunOptions,
+    stop: impl Fn() -> bool,
 ) -> anyhow::Result<(CirclesConfig, String)> {
-    let (mut config, source) = load(input)?;
+    let (mut config, source) = load(input, stop)?;
     if let Some(dt) = options.dt {
         config.dt = dt;
     }
@@ -165,13 +166,17 @@ pub(super) fn check_outputs(options: &RunOptions) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The configuration and the report's name for `input`.
-pub(super) fn load(input: &Input) -> anyhow::Result<(CirclesConfig, String)> {
+/// The configuration and the report's name for `input`; a particle file's reading asks
+/// `stop` before each line whether to give up.
+pub(super) fn load(
+    input: &Input,
+    stop: impl Fn() -> bool,
+) -> anyhow::Result<(CirclesConfig, String)> {
     Ok(match input {
         Input::Scene(path) => (Scene::load(path)?, path.display().to_string()),
         Input::Particles(path, boundary) => {
             let boundary = boundary.unwrap_or_default();
-            let circles = particles::read(path, boundary)?;
+            let circles = particles::read_until(path, boundary, stop)?;
             (
                 particles::to_config(circles, boundary),
                 path.display().to_string(),
