@@ -205,10 +205,16 @@ impl TryFrom<RunArgs> for RunOptions {
                 "--boundary applies to --particles files; a scene sets its own `arena.boundary`"
             ),
             (Some(scene), _) => Input::Scene(scene),
-            (None, Some(_)) if args.placement.is_some() || args.area_fraction.is_some() => bail!(
-                "--placement and --area-fraction spawn a scene's circles; a particle file lists \
-                 its own"
-            ),
+            (None, Some(_))
+                if args.placement.is_some()
+                    || args.area_fraction.is_some()
+                    || args.seed.is_some() =>
+            {
+                bail!(
+                    "--placement, --area-fraction and --seed spawn a scene's circles; a particle \
+                     file lists its own"
+                )
+            }
             (None, Some(file)) => Input::Particles(file, args.boundary),
             (None, None) => match args.resume {
                 Some(checkpoint) => Input::Resume(checkpoint),

@@ -203,6 +203,20 @@ impl CirclesConfig {
                 ),
             ));
         }
+        // The fixed clock counts whole nanoseconds: a step it would change by more than a
+        // millionth (below about half a millisecond, one not near a whole number of them) is
+        // refused, not run as another.
+        let clock = std::time::Duration::from_secs_f64(self.dt).as_secs_f64();
+        if (clock - self.dt).abs() > 1e-6 * self.dt {
+            return Err(FieldError::new(
+                "dt",
+                format!(
+                    "the fixed clock counts whole nanoseconds, so {} s would run as {clock} s; \
+                     give a step within a millionth of a whole number of nanoseconds",
+                    self.dt
+                ),
+            ));
+        }
         self.arena.check()?;
         self.effects.check()?;
         self.soft.check()?;

@@ -47,6 +47,10 @@ pub struct EosOptions {
     pub seed: u64,
 }
 
+/// The densest area fraction measured: a lattice of equal disks melted under `exact` (the
+/// lattice itself fits to about 0.88 in a square box).
+pub const MAX_AREA_FRACTION: f64 = 0.85;
+
 /// The default area fractions: 0.05 to 0.65 in steps of 0.05, then 0.68, 0.70 and 0.72 (the
 /// liquid–hexatic region).
 pub const DEFAULT_AREA_FRACTIONS: [f64; 16] = [
@@ -84,6 +88,12 @@ impl EosOptions {
             return Err(FieldError::new("area-fractions", "none given"));
         }
         for &phi in &self.area_fractions {
+            if !(phi > 0.0 && phi <= MAX_AREA_FRACTION) {
+                return Err(FieldError::new(
+                    "area-fractions",
+                    format!("each must be in (0, {MAX_AREA_FRACTION}], got {phi}"),
+                ));
+            }
             // The box and lattice are checked as a scene's are.
             config(self.n, phi, self.seed)
                 .check()

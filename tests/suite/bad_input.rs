@@ -57,6 +57,24 @@ fn dt_must_be_positive_and_sane() {
 }
 
 #[test]
+fn a_step_the_clock_cannot_count_is_refused_not_changed() {
+    // The fixed clock counts whole nanoseconds: 1.5 ns would run as 2 ns (or 1), a third off.
+    for dt in ["1.5e-9", "1.23456e-7"] {
+        assert_starts(
+            &scene_error(&format!("(dt: {dt})")),
+            "bad.ron: field `dt`: the fixed clock counts whole nanoseconds",
+        );
+    }
+    // A sixtieth of a second is 16 666 667 ns to 2e-8 of it; a whole number of nanoseconds is
+    // exact.
+    for dt in ["0.016666666666666666", "1e-9", "0.000123"] {
+        let scene = format!("(dt: {dt}, spawn: (count: 0))");
+        let config = Scene::parse(&scene, "ok.ron").and_then(|s| s.to_config("ok.ron"));
+        assert!(config.is_ok(), "{dt} refused: {config:?}");
+    }
+}
+
+#[test]
 fn the_arena_must_have_a_positive_finite_size() {
     assert_starts(
         &scene_error("(arena: (size: (0.0, 5.0)))"),
@@ -235,5 +253,16 @@ fn the_command_line_fails_cleanly_on_bad_files_and_flags() {
         "--boundary is for particle files: {err}"
     );
     assert!(!err.contains("panicked"), "{err}");
+
+    // A seed where no circle is placed at random would be ignored: refused, as --placement is.
+    let particles = ["--particles", "tests/data/particles/p10.txt"];
+    let cradle = ["--scene", "assets/scenes/cradle.ron"];
+    for (input, said) in [
+        (particles, "a particle file lists its own"),
+        (cradle, "has none"),
+    ] {
+        let (ok, err) = cli(&[&["run", "--steps", "1", "--seed", "5"][..], &input].concat());
+        assert!(!ok && err.contains("--seed") && err.contains(said), "{err}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -90,9 +90,18 @@ fn the_command_writes_a_csv_and_the_figure_and_refuses_bad_options() {
     let png = std::fs::read(out.join("eos.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"));
 
+    // The range the help gives, said as it gives it (0 and 1 were refused with what they made
+    // of the box and the step, 0.86 was run).
+    for phi in ["0", "0.86", "0.9", "1.0"] {
+        let refused = run(&["--out", out_arg, "--area-fractions", phi]);
+        let stderr = String::from_utf8_lossy(&refused.stderr);
+        assert!(!refused.status.success(), "{phi} accepted");
+        assert!(
+            stderr.contains("area-fractions") && stderr.contains("must be in (0, 0.85]"),
+            "{phi}: {stderr}"
+        );
+    }
     for (args, field) in [
-        (vec!["--area-fractions", "0.9"], "area-fractions"),
-        (vec!["--area-fractions", "0"], "area-fractions"),
         (vec!["--blocks", "1"], "blocks"),
         (vec!["--n", "1"], "n"),
         (vec!["--block", "NaN"], "block"),

@@ -42,6 +42,9 @@ pub(super) fn configure(
     }
     // The overrides go through the same check as the file did.
     config.check()?;
+    if options.seed.is_some() && config.spawn.target_count(&config.arena) == 0 {
+        bail!("--seed places a scene's random circles, and {source} has none (`spawn.count` 0)");
+    }
     config.solver = choose(&config, options.solver, options.tolerance)?;
     Ok((config, source))
 }
