@@ -10,15 +10,22 @@ use super::write_results;
 use crate::accuracy::piles::{pile_study, pile_table};
 use crate::accuracy::plot::AccuracyFigure;
 use crate::accuracy::report::{to_fronts, to_table};
-use crate::accuracy::{default_cases, pile_cases, pile_settings, settings, study};
-use crate::io::{csv_text, say, write_atomically};
+use crate::accuracy::{Case, default_cases, pile_cases, pile_settings, settings, study};
+use crate::io::{check_output_path, csv_text, say, write_atomically};
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
 /// writes its CSV and plot into `out`.
 pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
+    // Every scene read and every output checked before the first run: a bad pile scene or an
+    // unwritable piles.csv must not end the study after the gases have run and been written.
     let cases = default_cases(scenes, quick)?;
+    let pile_cases = pile_cases(scenes, quick)?;
     let settings = settings(quick);
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    for name in ["accuracy.csv", "accuracy.svg", "accuracy.png", "piles.csv"] {
+        let file = out.join(name);
+        check_output_path(&file).with_context(|| format!("cannot write {}", file.display()))?;
+    }
     let bar = indicatif::ProgressBar::new((cases.len() * (settings.len() + 1)) as u64).with_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {msg}")
             .expect("valid template"),
@@ -36,19 +43,19 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     to_table(&rows).lines().for_each(say);
     to_fronts(&rows).lines().for_each(say);
     write_results(&rows, &AccuracyFigure(&rows), out, "accuracy")?;
-    piles(out, scenes, quick)
+    piles(out, &pile_cases, quick)
 }
 
-/// The pile part of the study: runs it with a progress bar, prints its table and picks, and
-/// writes `piles.csv` into `out`.
-fn piles(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
-    let (cases, settings) = (pile_cases(scenes, quick)?, pile_settings(quick));
+/// The pile part of the study on `cases`: runs it with a progress bar, prints its table and
+/// picks, and writes `piles.csv` into `out`.
+fn piles(out: &Path, cases: &[Case], quick: bool) -> anyhow::Result<()> {
+    let settings = pile_settings(quick);
     let bar = indicatif::ProgressBar::new((cases.len() * settings.len()) as u64).with_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} pile runs  {msg}")
             .expect("valid template"),
     );
     let mut runs_done = 0;
-    let rows = pile_study(&cases, &settings, |case, (solver, dt)| {
+    let rows = pile_study(cases, &settings, |case, (solver, dt)| {
         bar.set_position(runs_done);
         runs_done += 1;
         bar.set_message(format!("{}: {solver} at {:.0} Hz", case.name, 1.0 / dt));

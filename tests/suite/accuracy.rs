@@ -176,3 +176,42 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
     }
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+#[test]
+fn a_bad_pile_scene_or_output_is_refused_before_any_run() {
+    // Both were found only after the gases had run and been written (a black-box try).
+    let dir = std::env::temp_dir().join(format!("mc-accuracy-bad-{}", std::process::id()));
+    let (scenes, out) = (dir.join("scenes"), dir.join("out"));
+    std::fs::create_dir_all(&scenes).unwrap();
+    for entry in std::fs::read_dir("assets/scenes").unwrap() {
+        let path = entry.unwrap().path();
+        std::fs::copy(&path, scenes.join(path.file_name().unwrap())).unwrap();
+    }
+    let study = || {
+        Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["accuracy", "--quick", "--scenes", scenes.to_str().unwrap()])
+            .args(["--out", out.to_str().unwrap()])
+            .output()
+            .unwrap()
+    };
+    let pyramid = scenes.join("pyramid.ron");
+    let good = std::fs::read_to_string(&pyramid).unwrap();
+    std::fs::write(&pyramid, "(dt: 1e-10)").unwrap();
+    let refused = study();
+    let said = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success(), "accepted: {said}");
+    assert!(
+        said.contains("pyramid.ron") && said.contains("dt"),
+        "{said}"
+    );
+    assert!(!out.join("accuracy.csv").exists(), "the gases ran first");
+    std::fs::write(&pyramid, good).unwrap();
+    std::fs::create_dir_all(out.join("piles.csv")).unwrap();
+    let refused = study();
+    let said = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success(), "accepted: {said}");
+    assert!(said.contains("piles.csv"), "{said}");
+    assert!(!out.join("accuracy.csv").exists(), "the gases ran first");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
