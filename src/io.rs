@@ -13,6 +13,12 @@ pub const MAX_SCENE_BYTES: u64 = 64 << 20;
 /// Most bytes of one line of a line-based input (particle files, checkpoints).
 pub const MAX_LINE_BYTES: usize = 4096;
 
+/// What some editors put before the text of a UTF-8 file, invisible in most, and a syntax
+/// error to RON and to the particle format.
+pub const BYTE_ORDER_MARK: char = '\u{feff}';
+/// What a file that begins with [`BYTE_ORDER_MARK`] is told.
+pub const BYTE_ORDER_MARK_MESSAGE: &str = "begins with a byte-order mark (U+FEFF, invisible in most editors): save it as UTF-8 without one";
+
 /// Reads all of `reader` as UTF-8 text, refusing it past `limit` bytes: a device or an endless
 /// file costs at most `limit` bytes of memory before the error. The error says what is wrong,
 /// without the file's name (the caller adds it).

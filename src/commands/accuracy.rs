@@ -21,7 +21,8 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     let cases = default_cases(scenes, quick)?;
     let pile_cases = pile_cases(scenes, quick)?;
     let settings = settings(quick);
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("--out: creating the folder {}", out.display()))?;
     for name in ["accuracy.csv", "accuracy.svg", "accuracy.png", "piles.csv"] {
         let file = out.join(name);
         check_output_path(&file).with_context(|| format!("cannot write {}", file.display()))?;

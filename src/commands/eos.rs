@@ -13,7 +13,8 @@ use crate::io::{check_output_path, say};
 /// Measures every area fraction of `options` and writes the results into `out`.
 pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
     options.check()?;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("--out: creating the folder {}", out.display()))?;
     let files = ["eos.csv", "eos.svg", "eos.png"].map(|name| out.join(name));
     for file in &files {
         check_output_path(file).with_context(|| format!("cannot write {}", file.display()))?;

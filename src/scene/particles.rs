@@ -14,7 +14,7 @@ use crate::arena::{Arena, Boundary};
 use crate::circle::CircleState;
 use crate::config::{CirclesConfig, MAX_CIRCLES, SpawnConfig};
 use crate::error::InputError;
-use crate::io::Lines;
+use crate::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE, Lines};
 
 /// Most bytes a particle file may have: a dump of the most circles an input may ask for, with
 /// every number written to full precision, fits.
@@ -84,6 +84,13 @@ fn parse_limited(
             "empty file: expected the number of circles on the first line",
         )
     })?;
+    if header.starts_with(BYTE_ORDER_MARK) {
+        return Err(InputError::line(
+            origin,
+            header_line,
+            BYTE_ORDER_MARK_MESSAGE,
+        ));
+    }
     let n: usize = header.parse().map_err(|_| {
         InputError::line(
             origin,
@@ -289,6 +296,10 @@ mod tests {
             (
                 "99999999999\n",
                 "f.txt: line 1: declares 99999999999 circles",
+            ),
+            (
+                "\u{feff}1\n0.5 0.5 0 0 0.1 1 0 0 0\n",
+                "f.txt: line 1: begins with a byte-order mark (U+FEFF",
             ),
             (
                 "2\n0.5 0.5 0 0 0.1 1 0 0 0\n",

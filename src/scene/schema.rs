@@ -9,6 +9,7 @@ use serde::Deserialize;
 use crate::arena::Boundary;
 use crate::config::{DropConfig, Effects, MassModel, SoftConfig, Solver, SpawnConfig};
 use crate::error::InputError;
+use crate::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE};
 
 /// The arena as a scene file gives it.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
@@ -115,6 +116,9 @@ impl Default for Scene {
 impl Scene {
     /// Reads a scene from RON text. `origin` names the source in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self, InputError> {
+        if text.starts_with(BYTE_ORDER_MARK) {
+            return Err(InputError::line(origin, 1, BYTE_ORDER_MARK_MESSAGE));
+        }
         let options = ron::Options::default()
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
         options.from_str::<Scene>(text).map_err(|e| InputError {

@@ -28,6 +28,15 @@ fn a_syntax_error_names_line_and_column() {
 }
 
 #[test]
+fn a_byte_order_mark_is_named() {
+    // Invisible in most editors; RON said only "Expected opening `(`".
+    assert_starts(
+        &scene_error("\u{feff}(dt: 0.01)"),
+        "bad.ron: line 1: begins with a byte-order mark (U+FEFF",
+    );
+}
+
+#[test]
 fn an_unknown_field_is_named() {
     let e = scene_error("(\n  efects: (collisions: false),\n)");
     assert_starts(&e, "bad.ron: line 2");
