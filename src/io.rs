@@ -108,6 +108,30 @@ impl<R: BufRead> Lines<R> {
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    stage(path, bytes)?.commit()
+}
+
+/// A file written whole beside where it goes, not yet in place: [`write_atomically`] in two
+/// halves, so that several outputs are all written before any replaces what was there, and then
+/// go in place one rename after another. Dropped uncommitted, it is removed and `path` is left as
+/// it was.
+#[derive(Debug)]
+pub struct Staged {
+    file: tempfile::NamedTempFile,
+    path: std::path::PathBuf,
+}
+
+impl Staged {
+    /// Puts the file in place of `path` (a rename).
+    pub fn commit(self) -> io::Result<()> {
+        self.file.persist(&self.path).map_err(|e| e.error)?;
+        Ok(())
+    }
+}
+
+/// Writes `bytes` to a temporary file beside `path`, as [`write_atomically`] does, and leaves it
+/// there until [`Staged::commit`].
+pub fn stage(path: &Path, bytes: &[u8]) -> io::Result<Staged> {
     check_output_path(path)?;
     let name = path.file_name().unwrap_or_default().to_string_lossy();
     let prefix = format!(".{name}.");
@@ -125,9 +149,12 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let mut file = builder.tempfile_in(directory_of(path))?;
     file.write_all(bytes)?;
     file.as_file().sync_all()?;
-    // On failure the temporary file comes back inside the error and is removed as it drops.
-    file.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    // On a failure to commit, the temporary file comes back inside the error and is removed as
+    // it drops.
+    Ok(Staged {
+        file,
+        path: path.to_owned(),
+    })
 }
 
 /// The end of [`write_atomically`]'s temporary file's name.
@@ -307,6 +334,26 @@ mod tests {
             .filter(|n| n.to_string_lossy().ends_with(".partial"))
             .collect();
         assert!(left.is_empty(), "{left:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn staged_files_replace_nothing_until_committed() {
+        let dir = std::env::temp_dir().join(format!("mc-staged-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("a.json"), dir.join("b.txt"));
+        std::fs::write(&a, "old a").unwrap();
+        std::fs::write(&b, "old b").unwrap();
+        let (new_a, new_b) = (stage(&a, b"new a").unwrap(), stage(&b, b"new b").unwrap());
+        // Both written, neither in place yet.
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a");
+        assert_eq!(std::fs::read_to_string(&b).unwrap(), "old b");
+        new_a.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "new a");
+        // Dropped uncommitted: the old file stays and the staged one is gone.
+        drop(new_b);
+        assert_eq!(std::fs::read_to_string(&b).unwrap(), "old b");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -17,7 +17,7 @@ use bevy::prelude::App;
 use crate::checkpoint::Checkpoint;
 use crate::circle::snapshot;
 use crate::config::Solver;
-use crate::io::{say, write_atomically};
+use crate::io::{self, say};
 use crate::run::{Progress, Report, advance, default_sampling, out_of_range, sample_end};
 use crate::scene::particles;
 use crate::schedule::{StepTotals, StopRequest};
@@ -175,29 +175,46 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             also.concat()
         );
     }
+    // Every output is written beside its place first, and only then are they put in place, one
+    // rename after another: a second signal while they are written (seconds, for millions of
+    // circles) leaves the old set, not some old and some new.
+    let mut staged = Vec::new();
+    let mut stage = |what: &str, path: &std::path::Path, bytes: anyhow::Result<Vec<u8>>| match bytes
+        .and_then(|bytes| {
+            io::stage(path, &bytes)
+                .with_context(|| format!("writing the {what} to {}", path.display()))
+        }) {
+        Ok(file) => staged.push((what.to_owned(), path.to_owned(), file)),
+        Err(e) => failed.push(e),
+    };
     if let Some(path) = &options.report {
-        let json = serde_json::to_string_pretty(&report).context("serialising the report")?;
-        if let Err(e) = write_atomically(path, (json + "\n").as_bytes()) {
-            failed.push(
-                anyhow::Error::new(e).context(format!("writing the report to {}", path.display())),
-            );
-        }
+        let json = serde_json::to_string_pretty(&report).context("serialising the report");
+        stage("report", path, json.map(|json| (json + "\n").into_bytes()));
     }
     if let Some(path) = &options.dump {
         let state = snapshot(app.world_mut());
-        if let Err(e) = write_atomically(path, particles::format(&state).as_bytes()) {
-            failed.push(
-                anyhow::Error::new(e)
-                    .context(format!("writing the final state to {}", path.display())),
-            );
-        }
+        stage(
+            "final state",
+            path,
+            Ok(particles::format(&state).into_bytes()),
+        );
     }
     // Once failed, the checkpoint is not tried again: the run stopped where it failed.
     if let Some(path) = &options.checkpoint
         && !checkpoint_failed
-        && let Err(e) = write_checkpoint(&mut app, &source, &progress, path)
     {
-        failed.push(e);
+        stage(
+            "checkpoint",
+            path,
+            checkpoint_bytes(&mut app, &source, &progress, path),
+        );
+    }
+    for (what, path, file) in staged {
+        if let Err(e) = file.commit() {
+            failed.push(
+                anyhow::Error::new(e).context(format!("writing the {what} to {}", path.display())),
+            );
+        }
     }
     if !failed.is_empty() {
         let all: Vec<String> = failed.iter().map(|e| format!("{e:#}")).collect();
@@ -217,7 +234,16 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
             ));
             Finished::Interrupted { signal }
         }
-        _ => Finished::Completed,
+        // After the last step, while the outputs were written: they are whole, and the exit
+        // status still says a signal came.
+        Some(signal) => {
+            say(format_args!(
+                "signal {signal} came after the last step, while the outputs were written; all \
+                 were written"
+            ));
+            Finished::Interrupted { signal }
+        }
+        None => Finished::Completed,
     })
 }
 
@@ -294,8 +320,20 @@ fn write_checkpoint(
     progress: &Progress,
     path: &std::path::Path,
 ) -> anyhow::Result<()> {
-    // Checked as our reader checks it, so that no checkpoint we write is one it refuses (a
-    // state past the range of values, a cached contact impulse past its bound).
+    let bytes = checkpoint_bytes(app, source, progress, path)?;
+    io::write_atomically(path, &bytes)
+        .with_context(|| format!("writing the checkpoint to {}", path.display()))
+}
+
+/// The checkpoint of `app` as bytes for `path`, checked as our reader checks it, so that no
+/// checkpoint we write is one it refuses (a state past the range of values, a cached contact
+/// impulse past its bound).
+fn checkpoint_bytes(
+    app: &mut App,
+    source: &str,
+    progress: &Progress,
+    path: &std::path::Path,
+) -> anyhow::Result<Vec<u8>> {
     let checkpoint = Checkpoint::take(app.world_mut(), source, progress);
     if let Err(why) = checkpoint.check() {
         bail!(
@@ -303,9 +341,7 @@ fn write_checkpoint(
             path.display()
         );
     }
-    let bytes = checkpoint.to_bytes();
-    write_atomically(path, &bytes)
-        .with_context(|| format!("writing the checkpoint to {}", path.display()))
+    Ok(checkpoint.to_bytes())
 }
 
 fn print_summary(r: &Report) {
