@@ -24,7 +24,7 @@ pub use measure::{
     Case, HORIZON_SECONDS, REFERENCE_DT, Row, SOLVERS, Trace, compare, passed_through, trace,
 };
 
-use crate::config::Solver;
+use crate::config::{CirclesConfig, Solver};
 use crate::error::InputError;
 use crate::scene::Scene;
 
@@ -45,6 +45,21 @@ fn each_solver_and_step(solvers: &[Solver], quick: bool) -> Vec<(Solver, f64)> {
         .collect()
 }
 
+/// The scene `name` of the study from `scenes_dir`, refused if it has no circle to measure
+/// (every error of the study would be 0/0).
+fn load_case(scenes_dir: &Path, name: &str) -> Result<CirclesConfig, InputError> {
+    let path = scenes_dir.join(format!("{name}.ron"));
+    let config = Scene::load(&path)?;
+    let placed = config.circles.len() + config.spawn.target_count(&config.arena);
+    if placed == 0 && config.drop.is_none() {
+        return Err(InputError::whole(
+            &path.display().to_string(),
+            "has no circles for the study to measure",
+        ));
+    }
+    Ok(config)
+}
+
 /// The study's cases (gas1k, gas, billiards, fast, and the rough gas, where rotation matters),
 /// from the scene files in `scenes_dir`; shorter runs when `quick`.
 pub fn default_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputError> {
@@ -60,7 +75,7 @@ pub fn default_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputE
         .map(|(name, seconds, quick_seconds, horizon)| {
             Ok(Case {
                 name: name.to_owned(),
-                config: Scene::load(&scenes_dir.join(format!("{name}.ron")))?,
+                config: load_case(scenes_dir, name)?,
                 seconds: if quick { quick_seconds } else { seconds },
                 horizon,
             })
@@ -80,7 +95,7 @@ pub fn pile_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputErro
         .map(|&(name, seconds)| {
             Ok(Case {
                 name: name.to_owned(),
-                config: Scene::load(&scenes_dir.join(format!("{name}.ron")))?,
+                config: load_case(scenes_dir, name)?,
                 seconds,
                 horizon: seconds,
             })

@@ -179,7 +179,7 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
 
 #[test]
 fn a_bad_pile_scene_or_output_is_refused_before_any_run() {
-    // Both were found only after the gases had run and been written (a black-box try).
+    // The last two were found only after the gases had run and been written (a black-box try).
     let dir = std::env::temp_dir().join(format!("mc-accuracy-bad-{}", std::process::id()));
     let (scenes, out) = (dir.join("scenes"), dir.join("out"));
     std::fs::create_dir_all(&scenes).unwrap();
@@ -195,6 +195,18 @@ fn a_bad_pile_scene_or_output_is_refused_before_any_run() {
             .output()
             .unwrap()
     };
+    // A scene with no circle would put 0/0 in every column: refused.
+    let gas1k = scenes.join("gas1k.ron");
+    let good = std::fs::read_to_string(&gas1k).unwrap();
+    std::fs::write(&gas1k, "(spawn: (count: 0))").unwrap();
+    let refused = study();
+    let said = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success(), "accepted: {said}");
+    assert!(
+        said.contains("gas1k.ron") && said.contains("no circles"),
+        "{said}"
+    );
+    std::fs::write(&gas1k, good).unwrap();
     let pyramid = scenes.join("pyramid.ron");
     let good = std::fs::read_to_string(&pyramid).unwrap();
     std::fs::write(&pyramid, "(dt: 1e-10)").unwrap();
