@@ -163,6 +163,10 @@ fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
          spawn: (placement: pack, count: 100000, radius: (0.1, 0.1), seed: 1))";
     signalled_while_placing(random, "placing at random 4000000");
     signalled_while_placing(pack, "compressing 100000");
+    // Fewer circles than that, in a box that holds a few hundred: each of the rest is tried 200
+    // times (seconds to minutes). It was placed without a word.
+    let crowded = "(spawn: (count: 999999, seed: 1))";
+    signalled_while_placing(crowded, "placing at random 999999");
 }
 
 /// Runs `scene`, signals it as soon as it says it is `placing` (its first line), and asserts

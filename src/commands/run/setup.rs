@@ -19,6 +19,10 @@ use crate::spawn::SpawnReport;
 const ANNOUNCE_SPAWN_FROM: usize = 1_000_000;
 /// The same for a `pack` placement, whose compression takes about a second per 5000 circles.
 const ANNOUNCE_PACK_FROM: usize = 20_000;
+/// The same for a random placement asked for at most this many tries in all (circles times
+/// `attempts_per_circle`): about 6 s when the arena is too full for most of them, since each
+/// circle that fits nowhere is tried every time (17 M tries a second, release build).
+const ANNOUNCE_TRIES_FROM: u64 = 100_000_000;
 
 /// The configuration of a scene or particle file with the command line's overrides, checked,
 /// and the report's name for it.
@@ -88,11 +92,13 @@ pub(super) fn start(
         Placement::Lattice => "placing on a lattice",
         Placement::Random => "placing at random",
     };
-    let announce_from = match config.spawn.placement {
-        Placement::Pack => ANNOUNCE_PACK_FROM,
-        _ => ANNOUNCE_SPAWN_FROM,
+    let tries = placing as u64 * u64::from(config.spawn.attempts_per_circle);
+    let announce = match config.spawn.placement {
+        Placement::Pack => placing >= ANNOUNCE_PACK_FROM,
+        Placement::Lattice => placing >= ANNOUNCE_SPAWN_FROM,
+        Placement::Random => placing >= ANNOUNCE_SPAWN_FROM || tries >= ANNOUNCE_TRIES_FROM,
     };
-    if placing >= announce_from {
+    if announce {
         eprintln!("moving_circles: {how} {placing} circles (this takes a while)");
     }
     let asked = stop.clone();
