@@ -12,7 +12,7 @@ use super::engine::{EngineSnapshot, EventEngine, EventStats, Rest, Roughness};
 use super::outside::{moved_since, turning_of};
 use crate::arena::Arena;
 use crate::circle::CircleState;
-use crate::collision_layers::{CircleFilters, CollisionLayers};
+use crate::collision_layers::CircleFilters;
 use crate::components::{
     AngularVelocity, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep, SolverCircles,
     SpinCircles, Velocity,
@@ -134,6 +134,7 @@ impl EngineState {
             (effects.restitution, effects.wall_restitution),
             effects.gravity.unwrap_or_default(),
             roughness(&effects),
+            effects.collisions,
         )?;
         engine.record_hits(effects.hit_messages);
         engine.set_own_restitutions(restitutions);
@@ -349,12 +350,7 @@ pub(super) fn gather_into_engine(
         }
     }
     let all = circles.p0();
-    // Without the collisions effect no pair meets: every circle's layers meet none, as a
-    // sensor's, so no circle looks for another (walls and segments still hold them).
-    let layers = match effects.collisions {
-        true => own.filters.gather(entities.iter().copied()),
-        false => vec![CollisionLayers::NONE; entities.len()],
-    };
+    let layers = own.filters.gather(entities.iter().copied());
     let restitutions = (effects.restitution, effects.wall_restitution);
     let fall = (effects.gravity, &rest[..]);
     let Some(mut engine) = EventEngine::build_until(
@@ -368,6 +364,8 @@ pub(super) fn gather_into_engine(
     ) else {
         return give_up(state);
     };
+    // Without the collisions effect circles pass through each other (they still hit walls).
+    engine.set_pairs(effects.collisions);
     if own.restitution {
         engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());
     }

@@ -275,6 +275,7 @@ impl EventEngine {
             segment_cells,
             own_restitution: Vec::new(),
             layers: Vec::new(),
+            pairs: true,
             hits: None,
             growth: 0.0,
             large,

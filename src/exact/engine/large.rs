@@ -211,6 +211,7 @@ mod tests {
             (1.0, 1.0),
             DVec2::ZERO,
             crate::exact::engine::Roughness::SMOOTH,
+            true,
         )
         .unwrap();
         original.advance_to(3.0, u64::MAX).unwrap();

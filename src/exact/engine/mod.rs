@@ -102,6 +102,9 @@ pub struct EventEngine {
     /// Each circle's layers, or empty when every pair meets: a pair that does not meet is
     /// never predicted.
     layers: Vec<CollisionLayers>,
+    /// Whether circles collide at all: off, as under a scene without the collisions effect, no
+    /// pair is predicted ([`EventEngine::set_pairs`]).
+    pairs: bool,
     /// Hits since the last [`EventEngine::drain_hits`], when recording.
     hits: Option<HitLog>,
     /// How fast radii grow: circle `i`'s radius is `radius·(1 + growth·t)`. 0 but in a
@@ -139,6 +142,16 @@ impl EventEngine {
     pub fn set_own_restitutions(&mut self, restitutions: Vec<f64>) {
         assert!(restitutions.is_empty() || restitutions.len() == self.len());
         self.own_restitution = restitutions;
+    }
+
+    /// Turns circle-circle collisions off (or on again) and predicts every circle again: off,
+    /// circles pass through each other and still hit walls and segment walls. Not part of a
+    /// snapshot: whoever restores one says it again ([`EventEngine::restore`]).
+    pub fn set_pairs(&mut self, on: bool) {
+        if self.pairs != on {
+            self.pairs = on;
+            self.predict_all();
+        }
     }
 
     /// Gives each circle its layers (one per circle, in order; empty: every pair meets) and
@@ -194,7 +207,7 @@ impl EventEngine {
     /// Whether circles `i` and `j` meet.
     #[inline]
     pub(super) fn meets(&self, i: usize, j: usize) -> bool {
-        pair_meets(&self.layers, i, j)
+        self.pairs && pair_meets(&self.layers, i, j)
     }
 
     /// Starts (or stops) recording every collision and wall hit, with its exact time, for

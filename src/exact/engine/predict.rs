@@ -30,6 +30,9 @@ impl EventEngine {
     /// The soonest collision of circle `i` with a circle in `cells` or a large circle that it
     /// meets, not before now.
     pub(super) fn scan(&self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
+        if !self.pairs {
+            return NO_PAIR;
+        }
         if self.images_wrap && self.gravity == DVec2::ZERO {
             self.scan_with::<false, true>(i, cells)
         } else if self.gravity == DVec2::ZERO {
@@ -45,7 +48,8 @@ impl EventEngine {
     /// neighbours, as in the cells a crossing newly borders, are cheaper one by one).
     fn scan_block(&mut self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
         #[cfg(target_arch = "x86_64")]
-        if self.gravity == DVec2::ZERO
+        if self.pairs
+            && self.gravity == DVec2::ZERO
             && !self.images_wrap
             && self.growth == 0.0
             && crate::vector::avx2()

@@ -19,6 +19,7 @@ fn restore_smooth(
         (1.0, 1.0),
         DVec2::ZERO,
         Roughness::SMOOTH,
+        true,
     )
 }
 
@@ -83,6 +84,7 @@ fn a_restored_engine_goes_on_bit_for_bit_as_the_original() {
             (1.0, 1.0),
             DVec2::ZERO,
             roughness,
+            true,
         )
         .unwrap();
         original.advance_to(5.0, u64::MAX).unwrap();
@@ -201,7 +203,16 @@ fn a_snapshot_whose_turning_does_not_fit_is_refused() {
     let now = circles_now(&engine, &circles);
     let good = engine.snapshot();
     let restore = |s: EngineSnapshot, circles: &[CircleState], roughness| {
-        EventEngine::restore(s, circles, &arena, &[], (1.0, 1.0), DVec2::ZERO, roughness)
+        EventEngine::restore(
+            s,
+            circles,
+            &arena,
+            &[],
+            (1.0, 1.0),
+            DVec2::ZERO,
+            roughness,
+            true,
+        )
     };
     assert!(restore(good.clone(), &now, ROUGH).is_ok());
     // Restored with other effects: smooth, or rough otherwise.
@@ -236,4 +247,31 @@ fn a_snapshot_whose_turning_does_not_fit_is_refused() {
     let mut smooth = good;
     smooth.spins = None;
     assert!(restore(smooth, &now, ROUGH).is_err());
+}
+
+#[test]
+fn an_engine_without_collisions_is_restored_only_as_one() {
+    let (circles, arena) = gas();
+    let restore = |s: EngineSnapshot, now: &[CircleState], pairs: bool| {
+        let (gravity, roughness) = (DVec2::ZERO, Roughness::SMOOTH);
+        EventEngine::restore(s, now, &arena, &[], (1.0, 1.0), gravity, roughness, pairs)
+    };
+    let mut apart = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
+    apart.set_pairs(false);
+    apart.advance_to(2.0, u64::MAX).unwrap();
+    assert_eq!(apart.stats().pair_collisions, 0, "they pass through");
+    let (snapshot, now) = (apart.snapshot(), circles_now(&apart, &circles));
+    let mut restored = restore(snapshot.clone(), &now, false).unwrap();
+    restored.advance_to(4.0, u64::MAX).unwrap();
+    apart.advance_to(4.0, u64::MAX).unwrap();
+    assert_eq!(restored.snapshot(), apart.snapshot(), "bit for bit");
+    // Read as an engine whose circles collide, it misses the pairs it never predicted; and an
+    // engine of colliding circles is not one without collisions.
+    let missed = restore(snapshot, &now, true).unwrap_err();
+    assert!(missed.contains("meet sooner"), "{missed}");
+    let mut colliding = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
+    colliding.advance_to(2.0, u64::MAX).unwrap();
+    let now = circles_now(&colliding, &circles);
+    let predicted = restore(colliding.snapshot(), &now, false).unwrap_err();
+    assert!(predicted.contains("has a best pair"), "{predicted}");
 }
