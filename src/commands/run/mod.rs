@@ -106,9 +106,11 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     let sampling = default_sampling(app.world().resource::<crate::spawn::SpawnReport>().placed);
     // What could not be written; the other outputs are written all the same.
     let mut failed: Vec<anyhow::Error> = Vec::new();
-    // The first sample whose state has left the range of values: nothing of it will be
-    // written, and such a state only gets further, so the run stops there, not at its end.
-    let left_range = std::cell::Cell::new(None);
+    // Whether a sample's state has left the range of values. Nothing of such a state may be
+    // written, and a run there spends its steps at speeds past what the clock resolves: it
+    // stops at that sample, not at its end (one that would have come back within the range by
+    // its end, which drag can do, is refused all the same).
+    let left_range = std::cell::Cell::new(false);
     let stopped = loop {
         let now = app.world().resource::<StepTotals>().steps;
         // Where the next checkpoint is due, or the end.
@@ -122,15 +124,15 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
         } else {
             due
         };
-        let stop = || interrupts.raised().is_some() || left_range.get().is_some();
+        let stop = || interrupts.raised().is_some() || left_range.get();
         let before = progress.stepping;
         let stopped = advance(&mut app, &mut progress, next, sampling, stop, |s| {
             bar.set_position(s.step - first);
             if out_of_range(s.world).is_some() {
-                left_range.set(Some(s.step));
+                left_range.set(true);
             }
         });
-        if left_range.get().is_some() {
+        if left_range.get() {
             break false;
         }
         if now == first && !stopped {

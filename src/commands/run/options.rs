@@ -94,7 +94,9 @@ pub struct RunOptions {
 pub enum Finished {
     /// It ran its length.
     Completed,
-    /// A signal stopped it after a step; everything asked for was written.
+    /// A signal stopped it: after a step, with everything asked for written; while its input
+    /// was read or its circles placed, with nothing written; or after its last step, while its
+    /// outputs were written (all of them).
     Interrupted {
         /// The signal's number (2 for SIGINT, 15 for SIGTERM).
         signal: i32,
