@@ -6,12 +6,12 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::write_results;
+use super::{prepare_out, write_results};
 use crate::accuracy::piles::{pile_study, pile_table};
 use crate::accuracy::plot::AccuracyFigure;
 use crate::accuracy::report::{to_fronts, to_table};
 use crate::accuracy::{Case, default_cases, pile_cases, pile_settings, settings, study};
-use crate::io::{check_output_path, csv_text, say, write_atomically};
+use crate::io::{csv_text, say, write_atomically};
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
 /// writes its CSV and plot into `out`.
@@ -21,12 +21,10 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     let cases = default_cases(scenes, quick)?;
     let pile_cases = pile_cases(scenes, quick)?;
     let settings = settings(quick);
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("--out: creating the folder {}", out.display()))?;
-    for name in ["accuracy.csv", "accuracy.svg", "accuracy.png", "piles.csv"] {
-        let file = out.join(name);
-        check_output_path(&file).with_context(|| format!("cannot write {}", file.display()))?;
-    }
+    prepare_out(
+        out,
+        &["accuracy.csv", "accuracy.svg", "accuracy.png", "piles.csv"],
+    )?;
     let bar = indicatif::ProgressBar::new((cases.len() * (settings.len() + 1)) as u64).with_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {msg}")
             .expect("valid template"),

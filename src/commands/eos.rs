@@ -3,22 +3,15 @@
 
 use std::path::Path;
 
-use anyhow::Context;
-
-use super::write_results;
+use super::{prepare_out, write_results};
 use crate::eos::plot::EosFigure;
 use crate::eos::{EosOptions, EosPoint, measure};
-use crate::io::{check_output_path, say};
+use crate::io::say;
 
 /// Measures every area fraction of `options` and writes the results into `out`.
 pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
     options.check()?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("--out: creating the folder {}", out.display()))?;
-    let files = ["eos.csv", "eos.svg", "eos.png"].map(|name| out.join(name));
-    for file in &files {
-        check_output_path(file).with_context(|| format!("cannot write {}", file.display()))?;
-    }
+    prepare_out(out, &["eos.csv", "eos.svg", "eos.png"])?;
     let bar = indicatif::ProgressBar::new(options.area_fractions.len() as u64).with_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} area fractions  {msg}")
             .expect("valid template"),

@@ -12,7 +12,7 @@ use std::path::Path;
 use anyhow::Context;
 
 use crate::figure::{Figure, png, svg};
-use crate::io::{csv_text, say, write_atomically};
+use crate::io::{check_output_path, csv_text, say, write_atomically};
 
 pub mod accuracy;
 #[cfg(feature = "render")]
@@ -20,6 +20,18 @@ pub mod app;
 pub mod eos;
 pub mod run;
 pub mod systems;
+
+/// Makes the folder `out` (`--out`) if it is missing and checks that each of `names` can be
+/// written in it, before any work whose results would go there.
+pub fn prepare_out(out: &Path, names: &[&str]) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("--out: creating the folder {}", out.display()))?;
+    for name in names {
+        let file = out.join(name);
+        check_output_path(&file).with_context(|| format!("cannot write {}", file.display()))?;
+    }
+    Ok(())
+}
 
 /// Writes `rows` as `<stem>.csv` and `figure` as `<stem>.svg` and `<stem>.png` inside `out`,
 /// each atomically, and says what it wrote.
