@@ -5,22 +5,26 @@ use bevy::math::DVec2;
 use super::*;
 use crate::arena::Boundary;
 
-/// [`EventEngine::restore`] of a smooth engine of the gas, elastic, without gravity.
+/// [`EventEngine::restore`] of an elastic engine without gravity or segment walls, with this
+/// roughness and whether its circles collide.
+fn restore_with(
+    s: EngineSnapshot,
+    now: &[CircleState],
+    arena: &Arena,
+    roughness: Roughness,
+    pairs: bool,
+) -> Result<EventEngine, String> {
+    let (restitutions, gravity) = ((1.0, 1.0), DVec2::ZERO);
+    EventEngine::restore(s, now, arena, &[], restitutions, gravity, roughness, pairs)
+}
+
+/// [`restore_with`] of a smooth engine of the gas.
 fn restore_smooth(
     s: EngineSnapshot,
     now: &[CircleState],
     arena: &Arena,
 ) -> Result<EventEngine, String> {
-    EventEngine::restore(
-        s,
-        now,
-        arena,
-        &[],
-        (1.0, 1.0),
-        DVec2::ZERO,
-        Roughness::SMOOTH,
-        true,
-    )
+    restore_with(s, now, arena, Roughness::SMOOTH, true)
 }
 
 fn gas() -> (Vec<CircleState>, Arena) {
@@ -76,17 +80,8 @@ fn a_restored_engine_goes_on_bit_for_bit_as_the_original() {
         original.advance_to(1.0, u64::MAX).unwrap();
         let now = circles_now(&original, &circles);
         let roughness = original.roughness();
-        let mut restored = EventEngine::restore(
-            original.snapshot(),
-            &now,
-            &arena,
-            &[],
-            (1.0, 1.0),
-            DVec2::ZERO,
-            roughness,
-            true,
-        )
-        .unwrap();
+        let mut restored =
+            restore_with(original.snapshot(), &now, &arena, roughness, true).unwrap();
         original.advance_to(5.0, u64::MAX).unwrap();
         restored.advance_to(5.0, u64::MAX).unwrap();
         assert!(original.stats().pair_collisions > 50);
@@ -203,16 +198,7 @@ fn a_snapshot_whose_turning_does_not_fit_is_refused() {
     let now = circles_now(&engine, &circles);
     let good = engine.snapshot();
     let restore = |s: EngineSnapshot, circles: &[CircleState], roughness| {
-        EventEngine::restore(
-            s,
-            circles,
-            &arena,
-            &[],
-            (1.0, 1.0),
-            DVec2::ZERO,
-            roughness,
-            true,
-        )
+        restore_with(s, circles, &arena, roughness, true)
     };
     assert!(restore(good.clone(), &now, ROUGH).is_ok());
     // Restored with other effects: smooth, or rough otherwise.
@@ -253,8 +239,7 @@ fn a_snapshot_whose_turning_does_not_fit_is_refused() {
 fn an_engine_without_collisions_is_restored_only_as_one() {
     let (circles, arena) = gas();
     let restore = |s: EngineSnapshot, now: &[CircleState], pairs: bool| {
-        let (gravity, roughness) = (DVec2::ZERO, Roughness::SMOOTH);
-        EventEngine::restore(s, now, &arena, &[], (1.0, 1.0), gravity, roughness, pairs)
+        restore_with(s, now, &arena, Roughness::SMOOTH, pairs)
     };
     let mut apart = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
     apart.set_pairs(false);
