@@ -63,12 +63,21 @@ pub struct Resting {
     pub pushing: bool,
     /// Its sleep state, updated in place.
     pub sleep: Sleep,
+    /// How far it may travel in the coming step (its speed times the step, and what gravity
+    /// adds): a stirring circle wakes what it may touch before the step ends, not only what it
+    /// touches now.
+    pub travel: f64,
 }
 
 impl Resting {
     /// Its centre, and the reach within which it touches another circle.
     fn touching_reach(&self) -> (DVec2, f64) {
         (self.position, self.radius * (1.0 + TOUCHING))
+    }
+
+    /// Its centre, and the reach within which it may touch another circle in the coming step.
+    fn waking_reach(&self) -> (DVec2, f64) {
+        (self.position, self.radius * (1.0 + TOUCHING) + self.travel)
     }
 
     /// Whether it is awake and not at rest for `time` (a movable circle), or pushing (a
@@ -110,8 +119,8 @@ impl IslandScratch {
             });
     }
 
-    /// The touching pairs that meet among the circles `chosen` selects, as positions in
-    /// `self.chosen`.
+    /// The pairs that meet among the circles `chosen` selects and whose waking reaches
+    /// ([`Resting::waking_reach`]) overlap, as positions in `self.chosen`.
     fn touching_pairs(
         &mut self,
         circles: &[Resting],
@@ -125,7 +134,7 @@ impl IslandScratch {
         let reach = self
             .chosen
             .iter()
-            .map(|&i| circles[i as usize].touching_reach());
+            .map(|&i| circles[i as usize].waking_reach());
         self.reach.extend(reach);
         self.pairs.clear();
         overlapping_pairs(&mut self.cells, arena, &self.reach, &mut self.pairs);
@@ -181,8 +190,8 @@ pub fn fall_asleep(
     fell
 }
 
-/// Wakes every sleeping circle of `circles` that a stirring circle touches (awake and not at
-/// rest for `time`, or kinematic and moving), together with every sleeping circle joined to
+/// Wakes every sleeping circle of `circles` that a stirring circle (awake and not at rest for
+/// `time`, or kinematic and moving) touches or may touch within its [`Resting::travel`], together with every sleeping circle joined to
 /// it through sleeping circles, and starts their timers again. Looks only at the sleeping and
 /// the stirring circles. Returns the circles that woke.
 pub fn wake_touched(
@@ -241,6 +250,7 @@ mod tests {
                 slow_for,
                 asleep: false,
             },
+            travel: 0.0,
         }
     }
 

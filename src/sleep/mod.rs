@@ -4,8 +4,9 @@
 //! island whose circles have all been slower than the sleep speed for the sleep time falls
 //! asleep (looked for a few times per sleep time, [`CHECKS_PER_SLEEP_TIME`]; velocities
 //! zeroed; the solvers then leave its circles where they are, as immovable circles at rest).
-//! A sleeping circle wakes, with every sleeping circle joined to it, in the step a circle that
-//! is not at rest touches it, or when your code writes its position, velocity, radius or mass.
+//! A sleeping circle wakes, with every sleeping circle joined to it, before the step in which
+//! a circle that is not at rest may touch it (within what that circle travels in a step), or
+//! when your code writes its position, velocity, radius or mass.
 //! Any change of the effects, the arena, the segment walls or the solver wakes every circle.
 //!
 //! At rest means within `speed · time` radii of where the circle last moved (its anchor):
@@ -155,6 +156,7 @@ fn update_sleep(
     }
     let config = effects.sleep;
     let dt = time.timestep().as_secs_f64();
+    let fall = 0.5 * effects.gravity.map_or(0.0, |g| g.length()) * dt * dt;
     let (resting, islands) = &mut *scratch;
     resting.clear();
     let (mut stirring, mut asleep, mut ready) = (false, 0usize, false);
@@ -187,12 +189,18 @@ fn update_sleep(
         }
         stirring |= pushing;
         asleep += usize::from(sleep.asleep);
+        let travel = if sleep.asleep {
+            0.0
+        } else {
+            velocity.0.length() * dt + if movable { fall } else { 0.0 }
+        };
         resting.push(Resting {
             position: position.0,
             radius: radius.0,
             movable,
             pushing,
             sleep: *sleep,
+            travel,
         });
     }
     // Layers only if a circle has them, from a query of their own (the same circles in the

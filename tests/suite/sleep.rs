@@ -1,12 +1,13 @@
 //! Sleeping under the time-stepped solvers: a heap at rest falls asleep and stays exactly where
-//! it is, a ball dropped onto it wakes it and it sleeps again, your code's writes wake a
+//! it is, a ball dropped onto it wakes it and it sleeps again (a fast one in the step it
+//! arrives, under every `soft=N`), your code's writes wake a
 //! sleeping circle, a change of the effects wakes them all, and nothing sleeps without gravity
 //! (a circle a checkpoint marks asleep is awake under `exact` and `swept` without it).
 
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::circle::{CircleState, snapshot};
+use moving_circles::circle::{CircleState, snapshot, snapshot_with_entities};
 use moving_circles::prelude::*;
 
 /// The time-stepped solvers that hold a heap at rest. `discrete`'s single contact pass does
@@ -122,6 +123,46 @@ fn a_ball_dropped_on_a_sleeping_heap_wakes_it_and_it_sleeps_again() {
         );
         let p = app.world().get::<Position>(ball).unwrap().0;
         assert!(p.y < 3.0, "{solver}: the ball did not land: {p}");
+    }
+}
+
+#[test]
+fn a_ball_that_reaches_a_sleeping_heap_within_one_step_wakes_it_in_that_step() {
+    // At 60 m/s the ball covers a metre a step: it starts 0.6 above the heap (far outside
+    // touching) and meets it before the step ends. The heap must wake before that step, so
+    // that the hit moves it, not bounce the ball off circles held as immovable.
+    for solver in ["soft", "soft=1", "soft=8", "substeps=4"] {
+        let mut app = heap(solver);
+        until_asleep(&mut app, 20.0).expect("asleep");
+        let top = snapshot(app.world_mut())
+            .iter()
+            .map(|c| c.position.y + c.radius)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let x = snapshot(app.world_mut())
+            .iter()
+            .max_by(|a, b| a.position.y.total_cmp(&b.position.y))
+            .unwrap()
+            .position
+            .x;
+        let ball = app
+            .world_mut()
+            .spawn((
+                Radius(0.25),
+                Position(DVec2::new(x, top + 0.25 + 0.6)),
+                Velocity(DVec2::new(0.0, -60.0)),
+                Mass(1.0),
+            ))
+            .id();
+        step(&mut app, 1);
+        let heap_moving = snapshot_with_entities(app.world_mut())
+            .iter()
+            .filter(|(e, c)| *e != ball && c.velocity != DVec2::ZERO)
+            .count();
+        let awake = asleep(&mut app).iter().filter(|&&s| !s).count();
+        assert!(
+            awake > 1 && heap_moving > 0,
+            "{solver}: {awake} awake, {heap_moving} of the heap moving after the hit"
+        );
     }
 }
 
