@@ -6,11 +6,12 @@
 use bevy::math::DVec2;
 
 use super::bodies::{Bodies, Softness};
+pub use super::rules::ContactRules;
+use super::rules::impact;
 use crate::arena::Arena;
 use crate::collide::contact::{combine_restitution, contact_normal};
 use crate::collide::pair_list::{PairList, SKIN};
 use crate::collision_layers::{meets_any, pair_meets};
-use crate::config::Combine;
 use crate::exact::toi::pair_time_of_impact;
 use crate::grid::NONE;
 use crate::hits::{ArenaWall, Wall};
@@ -59,7 +60,9 @@ pub struct Constraint {
     pub threshold: f64,
     /// Fastest push-out speed.
     pub push: f64,
-    /// Normal velocity of `b` relative to `a` when the step began (negative: approaching).
+    /// Normal velocity of `b` relative to `a` when the step began (negative: approaching), or,
+    /// where gravity closes the gap to a wall or an immovable circle, the one they meet with
+    /// (`rules.rs`): what a bounce reverses.
     pub relative_velocity: f64,
     /// Impulse accumulated in the current substep (warm started from the last one's).
     pub impulse: f64,
@@ -88,31 +91,6 @@ impl Constraint {
 #[inline(always)]
 pub fn larger(a: f64, b: f64) -> f64 {
     if a > b { a } else { b }
-}
-
-/// The tuning every contact of a step shares.
-#[derive(Clone, Copy, Debug)]
-pub struct ContactRules {
-    /// The fixed step.
-    pub dt: f64,
-    /// Constant acceleration, or zero.
-    pub gravity: DVec2,
-    /// Restitution between circles and against walls, for circles without their own.
-    pub restitution: (f64, f64),
-    /// Softness against movable circles, and against immovable ones and walls.
-    pub soft: (Softness, Softness),
-    /// Push-out speed and restitution threshold, in radii per second.
-    pub push_speed: f64,
-    /// See [`ContactRules::push_speed`].
-    pub threshold: f64,
-    /// Whether circles collide with each other at all.
-    pub collisions: bool,
-    /// Friction between circles and against walls, for circles without their own.
-    pub friction: (f64, f64),
-    /// How two friction coefficients meet.
-    pub combine: Combine,
-    /// Rolling resistance (dimensionless).
-    pub rolling_resistance: f64,
 }
 
 /// The friction and rolling rows of a contact: what it needs besides its normal push to stop
@@ -386,6 +364,14 @@ fn pair_contact(
         bodies.restitution_of(i, rules.restitution.0),
         bodies.restitution_of(j, rules.restitution.0),
     );
+    // Gravity closes the gap only against an immovable partner.
+    let accel = match (wa > 0.0, wb > 0.0) {
+        (true, false) => -rules.gravity.dot(normal),
+        (false, true) => rules.gravity.dot(normal),
+        _ => 0.0,
+    };
+    let (relative_velocity, threshold) =
+        impact(rules, dv.dot(normal), accel, d.dot(normal) - reach, smaller);
     Some(Constraint {
         a: i as u32,
         b: j as u32,
@@ -401,9 +387,9 @@ fn pair_contact(
             rules.soft.0
         },
         restitution,
-        threshold: rules.threshold * smaller,
+        threshold,
         push: rules.push_speed * smaller,
-        relative_velocity: (vb - va).dot(normal),
+        relative_velocity,
         impulse: 0.0,
         total_impulse: 0.0,
         approach: 0.0,
@@ -424,6 +410,13 @@ fn wall_contact(
 ) -> Constraint {
     let (r, w) = (bodies.radius[i], bodies.inv_mass[i]);
     let own = bodies.restitution_of(i, rules.restitution.1);
+    let (relative_velocity, threshold) = impact(
+        rules,
+        -bodies.velocity[i].dot(normal),
+        -rules.gravity.dot(normal),
+        (anchor - bodies.position[i]).dot(normal) - r,
+        r,
+    );
     Constraint {
         a: i as u32,
         b: NONE,
@@ -435,9 +428,9 @@ fn wall_contact(
         normal_mass: 1.0 / w,
         soft: rules.soft.1,
         restitution: combine_restitution(own, rules.restitution.1),
-        threshold: rules.threshold * r,
+        threshold,
         push: rules.push_speed * r,
-        relative_velocity: -bodies.velocity[i].dot(normal),
+        relative_velocity,
         impulse: 0.0,
         total_impulse: 0.0,
         approach: 0.0,

@@ -16,6 +16,7 @@ pub mod cache;
 pub mod colours;
 pub mod contacts;
 pub mod friction;
+mod rules;
 pub mod sequential;
 pub mod solve;
 pub mod stats;

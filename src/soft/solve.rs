@@ -3,8 +3,8 @@
 //! [`ContactCache`]); then per substep integrate velocities (gravity, drag), apply the warm
 //! start, solve the contacts with their soft bias (and their friction, [`super::friction`]),
 //! integrate positions and rotations and relax (solve again without the bias, so the push-out
-//! leaves no velocity behind); once after the substeps, the restitution pass; last, store the
-//! impulses for the next step.
+//! leaves no velocity behind); once after the substeps, the restitution passes; last, store
+//! the impulses for the next step.
 //!
 //! Contacts are solved in a fixed order (Gauss-Seidel): arena and segment walls first, one
 //! after another ([`super::sequential`]); then the pairs, in a step without friction colour by
@@ -61,6 +61,7 @@ pub struct SoftScratch {
     walls: Vec<Constraint>,
     rows: Vec<TurningRow>,
     colours: Colours,
+    bouncing: (Vec<u32>, Vec<u32>),
 }
 
 /// Advances `bodies` by one step of `params.dt` in `arena` among `segments` (with the cells
@@ -154,6 +155,7 @@ fn soft_part(
     let zeta = params.config.damping_ratio;
     let rules = ContactRules {
         dt: params.dt,
+        substep: h,
         gravity: params.gravity,
         restitution: params.restitution,
         soft: (
@@ -173,6 +175,7 @@ fn soft_part(
         walls,
         rows,
         colours,
+        bouncing,
     } = scratch;
     find_contacts(bodies, arena, segments, &rules, contacts, (pairs, walls));
     rows.clear();
@@ -204,7 +207,7 @@ fn soft_part(
             turning_substep(bodies, contacts, h, &mut work);
         }
     }
-    restitution(bodies, (walls, pairs), &mut work);
+    restitution(bodies, (walls, pairs), bouncing, &mut work);
     cache.store(&bodies.id, walls.iter().chain(pairs.iter()), rows);
     keep_inside(bodies, arena);
     let mut stats = SoftStats {

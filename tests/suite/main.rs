@@ -42,6 +42,7 @@ mod segments;
 mod sensors;
 mod signals;
 mod sleep;
+mod soft_promises;
 mod solvers;
 mod spawn;
 mod transform_sync;

@@ -161,6 +161,14 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     let mut report = Report::new(app.world_mut(), &source, &ended);
     report.interrupted = stopped;
     print_summary(&report);
+    if report.final_penetration >= SUNK {
+        eprintln!(
+            "moving_circles: warning: circles ended {:.2} radii deep in each other \
+             (final_penetration): the solver's settings do not hold this scene (under `soft`, \
+             a stiffer soft.hertz, more substeps or a shorter dt do)",
+            report.final_penetration
+        );
+    }
     if !report.is_finite() {
         bail!(
             "the run's state became non-finite ({} circles); nothing was written",
@@ -345,6 +353,11 @@ fn checkpoint_bytes(
     }
     Ok(checkpoint.to_bytes())
 }
+
+/// Overlap at the end (in the smaller radius) from which a run warns that circles sank into
+/// each other: no solver's resting contacts come near it unless its settings cannot hold the
+/// scene.
+const SUNK: f64 = 1.0;
 
 fn print_summary(r: &Report) {
     say(format_args!(

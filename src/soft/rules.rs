@@ -1,0 +1,66 @@
+//! What every contact of a `soft` step shares ([`ContactRules`]), and the speed a contact
+//! bounces from (`impact`).
+
+use bevy::math::DVec2;
+
+use super::bodies::Softness;
+use crate::config::Combine;
+
+/// The tuning every contact of a step shares.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactRules {
+    /// The fixed step.
+    pub dt: f64,
+    /// One substep of it.
+    pub substep: f64,
+    /// Constant acceleration, or zero.
+    pub gravity: DVec2,
+    /// Restitution between circles and against walls, for circles without their own.
+    pub restitution: (f64, f64),
+    /// Softness against movable circles, and against immovable ones and walls.
+    pub soft: (Softness, Softness),
+    /// Push-out speed and restitution threshold, in radii per second.
+    pub push_speed: f64,
+    /// See [`ContactRules::push_speed`].
+    pub threshold: f64,
+    /// Whether circles collide with each other at all.
+    pub collisions: bool,
+    /// Friction between circles and against walls, for circles without their own.
+    pub friction: (f64, f64),
+    /// How two friction coefficients meet.
+    pub combine: Combine,
+    /// Rolling resistance (dimensionless).
+    pub rolling_resistance: f64,
+}
+
+/// The normal velocity a contact bounces from, and below which it does not bounce, for two
+/// sides whose normal velocity is `now` (negative: approaching), whose relative acceleration
+/// along the normal is `accel` (negative: closing) and whose gap is `gap`, the smaller radius
+/// being `r`.
+///
+/// Under an acceleration that closes the gap (gravity towards a wall or a peg), the speed at
+/// impact is what the fall over the gap adds, taken so that the energy the substeps keep
+/// (`v²/2 + a·y − a·h·v/2` for symplectic Euler with substep `h`, which moves a circle with
+/// its velocity after gravity's kick) is the same after the bounce as before the step: a
+/// bounce that reversed the plain impact speed would lose `a·h` of speed at every hit. The
+/// threshold is the scene's under gravity; without gravity nothing rests, so every approach
+/// bounces.
+pub(super) fn impact(rules: &ContactRules, now: f64, accel: f64, gap: f64, r: f64) -> (f64, f64) {
+    let threshold = if rules.gravity == DVec2::ZERO {
+        0.0
+    } else {
+        rules.threshold * r
+    };
+    if accel < 0.0 {
+        let (a, h) = (-accel, rules.substep);
+        let fall = if gap > 0.0 { 2.0 * a * gap } else { 0.0 };
+        let kick = 0.5 * a * h;
+        let out = kick
+            + (kick * kick + now * now + fall - a * h * now)
+                .max(0.0)
+                .sqrt();
+        (-out, threshold)
+    } else {
+        (now, threshold)
+    }
+}
