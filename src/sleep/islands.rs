@@ -191,8 +191,9 @@ pub fn fall_asleep(
 }
 
 /// Wakes every sleeping circle of `circles` that a stirring circle (awake and not at rest for
-/// `time`, or kinematic and moving) touches or may touch within its [`Resting::travel`], together with every sleeping circle joined to
-/// it through sleeping circles, and starts their timers again. Looks only at the sleeping and
+/// `time`, or kinematic and moving) touches or may touch within its [`Resting::travel`],
+/// together with every sleeping circle joined to it through sleeping circles, and starts their
+/// timers again. Looks only at the sleeping and
 /// the stirring circles. Returns the circles that woke.
 pub fn wake_touched(
     circles: &mut [Resting],

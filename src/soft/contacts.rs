@@ -370,8 +370,7 @@ fn pair_contact(
         (false, true) => rules.gravity.dot(normal),
         _ => 0.0,
     };
-    let (relative_velocity, threshold) =
-        impact(rules, dv.dot(normal), accel, d.dot(normal) - reach, smaller);
+    let relative_velocity = impact(rules, dv.dot(normal), accel, d.dot(normal) - reach);
     Some(Constraint {
         a: i as u32,
         b: j as u32,
@@ -387,7 +386,7 @@ fn pair_contact(
             rules.soft.0
         },
         restitution,
-        threshold,
+        threshold: rules.threshold * smaller,
         push: rules.push_speed * smaller,
         relative_velocity,
         impulse: 0.0,
@@ -410,12 +409,11 @@ fn wall_contact(
 ) -> Constraint {
     let (r, w) = (bodies.radius[i], bodies.inv_mass[i]);
     let own = bodies.restitution_of(i, rules.restitution.1);
-    let (relative_velocity, threshold) = impact(
+    let relative_velocity = impact(
         rules,
         -bodies.velocity[i].dot(normal),
         -rules.gravity.dot(normal),
         (anchor - bodies.position[i]).dot(normal) - r,
-        r,
     );
     Constraint {
         a: i as u32,
@@ -428,7 +426,7 @@ fn wall_contact(
         normal_mass: 1.0 / w,
         soft: rules.soft.1,
         restitution: combine_restitution(own, rules.restitution.1),
-        threshold,
+        threshold: rules.threshold * r,
         push: rules.push_speed * r,
         relative_velocity,
         impulse: 0.0,

@@ -21,7 +21,8 @@ pub struct ContactRules {
     pub soft: (Softness, Softness),
     /// Push-out speed and restitution threshold, in radii per second.
     pub push_speed: f64,
-    /// See [`ContactRules::push_speed`].
+    /// See [`ContactRules::push_speed`]; 0 without gravity, where nothing rests and every
+    /// approach bounces.
     pub threshold: f64,
     /// Whether circles collide with each other at all.
     pub collisions: bool,
@@ -33,34 +34,24 @@ pub struct ContactRules {
     pub rolling_resistance: f64,
 }
 
-/// The normal velocity a contact bounces from, and below which it does not bounce, for two
-/// sides whose normal velocity is `now` (negative: approaching), whose relative acceleration
-/// along the normal is `accel` (negative: closing) and whose gap is `gap`, the smaller radius
-/// being `r`.
+/// The normal velocity a contact bounces from, for two sides whose normal velocity is `now`
+/// (negative: approaching), whose relative acceleration along the normal is `accel`
+/// (negative: closing) and whose gap is `gap`.
 ///
 /// Under an acceleration that closes the gap (gravity towards a wall or a peg), the speed at
 /// impact is what the fall over the gap adds, taken so that the energy the substeps keep
 /// (`v²/2 + a·y − a·h·v/2` for symplectic Euler with substep `h`, which moves a circle with
 /// its velocity after gravity's kick) is the same after the bounce as before the step: a
-/// bounce that reversed the plain impact speed would lose `a·h` of speed at every hit. The
-/// threshold is the scene's under gravity; without gravity nothing rests, so every approach
-/// bounces.
-pub(super) fn impact(rules: &ContactRules, now: f64, accel: f64, gap: f64, r: f64) -> (f64, f64) {
-    let threshold = if rules.gravity == DVec2::ZERO {
-        0.0
-    } else {
-        rules.threshold * r
-    };
-    if accel < 0.0 {
-        let (a, h) = (-accel, rules.substep);
-        let fall = if gap > 0.0 { 2.0 * a * gap } else { 0.0 };
-        let kick = 0.5 * a * h;
-        let out = kick
-            + (kick * kick + now * now + fall - a * h * now)
-                .max(0.0)
-                .sqrt();
-        (-out, threshold)
-    } else {
-        (now, threshold)
+/// bounce that reversed the plain impact speed would lose `a·h` of speed at every hit.
+pub(super) fn impact(rules: &ContactRules, now: f64, accel: f64, gap: f64) -> f64 {
+    if accel >= 0.0 {
+        return now;
     }
+    let (a, h) = (-accel, rules.substep);
+    let fall = if gap > 0.0 { 2.0 * a * gap } else { 0.0 };
+    let kick = 0.5 * a * h;
+    -(kick
+        + (kick * kick + now * now + fall - a * h * now)
+            .max(0.0)
+            .sqrt())
 }

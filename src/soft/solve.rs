@@ -163,7 +163,12 @@ fn soft_part(
             Softness::new(2.0 * hertz, zeta, h),
         ),
         push_speed: params.config.push_speed,
-        threshold: params.config.restitution_threshold,
+        // Without gravity nothing rests, so every approach bounces.
+        threshold: if params.gravity == DVec2::ZERO {
+            0.0
+        } else {
+            params.config.restitution_threshold
+        },
         collisions: params.collisions,
         friction: params.friction,
         combine: params.combine,
