@@ -229,7 +229,7 @@ impl ContactCache {
             self.stored.push(Cached {
                 partner: c.partner,
                 impulse: c.impulse,
-                touching: c.total_impulse > 0.0,
+                touching: c.pressing,
                 tangent,
                 rolling,
             });

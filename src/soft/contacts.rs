@@ -71,8 +71,12 @@ pub struct Constraint {
     /// Fastest approach along the normal the solver met in the step (what a hit's message
     /// calls its normal speed).
     pub approach: f64,
-    /// Whether the contact pushed in the last step (a new push is a collision to count).
+    /// Whether the contact still pressed when the last step ended (a new push is a collision
+    /// to count, and may bounce).
     pub was_touching: bool,
+    /// Whether it still presses when the step ends: it pushed, and its two sides do not part
+    /// faster than its threshold (the next step's `was_touching`; set by the restitution).
+    pub pressing: bool,
     /// Its [`TurningRow`]'s index in the step's rows, or `NONE` (`u32::MAX`) without friction.
     pub turn: u32,
 }
@@ -393,6 +397,7 @@ fn pair_contact(
         total_impulse: 0.0,
         approach: 0.0,
         was_touching: false,
+        pressing: false,
         turn: NONE,
     })
 }
@@ -433,6 +438,7 @@ fn wall_contact(
         total_impulse: 0.0,
         approach: 0.0,
         was_touching: false,
+        pressing: false,
         turn: NONE,
     }
 }

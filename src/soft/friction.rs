@@ -157,6 +157,7 @@ mod tests {
             total_impulse: 1.0,
             approach: 0.0,
             was_touching: true,
+            pressing: true,
             turn: 0,
         };
         let row = TurningRow {

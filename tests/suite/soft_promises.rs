@@ -52,7 +52,7 @@ fn the_seeds_scene_keeps_its_energy_under_every_soft() {
 #[test]
 fn an_elastic_gas_keeps_more_than_half_its_energy_under_soft() {
     // A thousand circles at area fraction 0.3: hits from two sides in one step are common
-    // (measured: -0.34 in 10 s; it lost 0.82 when one restitution pass served them).
+    // (measured: -0.33 in 10 s; it lost 0.82 when one restitution pass served them).
     let r = report(
         "gas1k",
         &[

@@ -30,6 +30,7 @@ fn contact(a: u32, b: u32, impulse: f64) -> Constraint {
         total_impulse: impulse,
         approach: 0.0,
         was_touching: false,
+        pressing: false,
         turn: NONE,
     }
 }

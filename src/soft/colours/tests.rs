@@ -50,6 +50,7 @@ fn scene(seed: u64, circles: usize, n: usize) -> (Vec<Constraint>, Vec<DVec2>, V
                 total_impulse: 0.0,
                 approach: 0.0,
                 was_touching: false,
+                pressing: false,
                 turn: NONE,
             })
         })
