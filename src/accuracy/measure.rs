@@ -38,12 +38,14 @@ pub const REFERENCE_DT: f64 = 1.0 / 60.0;
 
 /// The solvers the study compares, cheapest first by design (the measurement decides); the
 /// last, `exact`, is the reference.
-pub const SOLVERS: [Solver; 7] = [
+pub const SOLVERS: [Solver; 9] = [
     Solver::Discrete,
     Solver::Substeps(2),
     Solver::Substeps(4),
     Solver::Substeps(8),
     Solver::Substeps(16),
+    Solver::Soft(4),
+    Solver::Soft(8),
     Solver::Swept,
     Solver::Exact,
 ];

@@ -18,17 +18,21 @@ pub const FIGURE_SIZE: (u32, u32) = (1600, 1290);
 /// Height of the title and legend strip above the panels.
 const STRIP: u32 = 130;
 
-/// One colour per solver setting: a family shares a hue (substeps from light to dark).
-const SETTINGS: [(&str, RGBColor); 7] = [
+/// One colour per solver setting: a family shares a hue (substeps and soft from light to dark).
+const SETTINGS: [(&str, RGBColor); 9] = [
     ("discrete", RGBColor(215, 48, 39)),
     ("substeps=2", RGBColor(161, 217, 155)),
     ("substeps=4", RGBColor(94, 185, 100)),
     ("substeps=8", RGBColor(35, 139, 69)),
     ("substeps=16", RGBColor(0, 90, 50)),
+    ("soft", RGBColor(253, 174, 97)),
+    ("soft=8", RGBColor(217, 95, 2)),
     ("swept", RGBColor(33, 113, 181)),
     ("exact", RGBColor(117, 80, 170)),
 ];
 
+/// The reference's colour (the last setting, `exact`).
+const EXACT: RGBColor = SETTINGS[SETTINGS.len() - 1].1;
 const FRONT: RGBColor = RGBColor(255, 200, 60);
 const GRID: RGBColor = RGBColor(225, 225, 225);
 
@@ -124,7 +128,7 @@ fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, rows: &[Row]) -> R
         ))
         .map_err(err)?;
     x += 400;
-    let exact = SETTINGS[6].1;
+    let exact = EXACT;
     for k in 0..4 {
         strip
             .draw(&PathElement::new(
@@ -218,7 +222,7 @@ fn panel<DB: DrawingBackend>(
                 [(cost(reference), zero), (cost(reference), y_hi)],
                 4,
                 4,
-                SETTINGS[6].1.stroke_width(2),
+                EXACT.stroke_width(2),
             ))
             .map_err(err)?;
     }

@@ -54,7 +54,11 @@ fn auto_picks_a_continuous_solver_for_a_tight_tolerance_and_a_cheap_one_for_a_lo
         tight.is_continuous(),
         "1e-6 of a radius needs swept or exact, got {tight}: {measured:?}"
     );
-    assert_eq!(measured.len(), 7, "six candidates and exact");
+    assert_eq!(
+        measured.len(),
+        9,
+        "eight candidates (soft among them) and exact"
+    );
     // With any error allowed, the choice is the cheapest of that calibration's measurements.
     let (loose, measured) = choose_solver(&fast_scene(), 1e6);
     let cheapest = measured
@@ -78,7 +82,14 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
         String::from_utf8_lossy(&status.stderr)
     );
     let csv = std::fs::read_to_string(out.join("accuracy.csv")).unwrap();
-    for solver in ["discrete", "substeps=16", "swept", "exact"] {
+    for solver in [
+        "discrete",
+        "substeps=16",
+        "soft",
+        "soft=8",
+        "swept",
+        "exact",
+    ] {
         for scene in ["gas1k", "gas", "billiards", "fast", "rough_gas"] {
             assert!(
                 csv.lines()
