@@ -26,9 +26,9 @@ fn the_seeds_scene_keeps_its_energy_under_every_soft() {
     // 32 circles, restitution 1, no gravity: every hit bounces (nothing can rest), and the
     // bounces of one step are solved together. A single hit lost to a resting rule or to a
     // single restitution pass costs a whole circle's normal energy: 10 % and more in 10 s.
-    // One substep (`soft=1`) lets some hits end in overlap, which the push-out and the
-    // relax pass settle without the energy: 1 % in 10 s (12 % before bounces were solved together).
-    for (solver, most) in [("soft", 1e-3), ("soft=8", 1e-3), ("soft=1", 2e-2)] {
+    // One substep (`soft=1`) keeps 9e-4 of it in 10 s (12 % was lost before bounces were
+    // solved together).
+    for (solver, most) in [("soft", 1e-3), ("soft=8", 1e-3), ("soft=1", 2e-3)] {
         let r = report(
             "classic",
             &[
@@ -50,9 +50,9 @@ fn the_seeds_scene_keeps_its_energy_under_every_soft() {
 }
 
 #[test]
-fn an_elastic_gas_keeps_more_than_half_its_energy_under_soft() {
+fn an_elastic_gas_keeps_most_of_its_energy_under_soft() {
     // A thousand circles at area fraction 0.3: hits from two sides in one step are common
-    // (measured: -0.33 in 10 s; it lost 0.82 when one restitution pass served them).
+    // (measured: -0.11 in 10 s; it lost 0.82 when one restitution pass served them).
     let r = report(
         "gas1k",
         &[
@@ -65,7 +65,7 @@ fn an_elastic_gas_keeps_more_than_half_its_energy_under_soft() {
             "10",
         ],
     );
-    assert!(drift(&r).abs() < 0.5, "drift {}", drift(&r));
+    assert!(drift(&r).abs() < 0.2, "drift {}", drift(&r));
 }
 
 #[test]
@@ -127,5 +127,75 @@ fn circles_that_sink_into_each_other_are_never_silent() {
     );
     let held = heap(60.0);
     assert!(!held.contains("warning"), "{held}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_ball_never_crosses_a_segment_wall_under_soft_at_any_speed() {
+    // Speculative contacts reach as far as a circle travels in a part of the step, and a step
+    // is split into at most 64 parts: past 64 radii a step, a part crosses many radii, and only
+    // the contact's reach keeps the ball on its side. Falling onto a floor segment under
+    // gravity, and flying sideways into a wall segment, from 100 to 10⁵ m/s.
+    let dir = scratch_dir("soft_promises", "crossing");
+    let scene = dir.join("crossing.ron");
+    let dump = dir.join("end.txt");
+    let (scene_path, dump_path) = (scene.to_str().unwrap(), dump.to_str().unwrap());
+    for solver in ["soft", "soft=1", "soft=8"] {
+        for radius in [0.005, 0.1] {
+            for speed in [100.0, 1e4, 1e5] {
+                for (segment, velocity, gravity) in [
+                    (
+                        "[(-5.0, 0.0), (5.0, 0.0)]",
+                        format!("(0.0, -{speed})"),
+                        "(0.0, -9.81)",
+                    ),
+                    (
+                        "[(5.0, -5.0), (5.0, 5.0)]",
+                        format!("({speed}, 0.0)"),
+                        "(0.0, 0.0)",
+                    ),
+                ] {
+                    std::fs::write(
+                        &scene,
+                        format!(
+                            "(arena: (size: (40.0, 40.0), boundary: walls),
+                              effects: (collisions: true, gravity: {gravity},
+                                        restitution: 1.0, wall_restitution: 1.0),
+                              segments: [{segment}],
+                              circles: [(position: (0.0, 3.0), radius: {radius},
+                                         velocity: {velocity})])"
+                        ),
+                    )
+                    .unwrap();
+                    for steps in ["1", "60"] {
+                        let args = [
+                            "run", "--scene", scene_path, "--solver", solver, "--steps", steps,
+                            "--dump", dump_path,
+                        ];
+                        successful(&args);
+                        let text = std::fs::read_to_string(&dump).unwrap();
+                        let last = text.lines().filter(|l| !l.trim().is_empty()).last();
+                        let fields: Vec<f64> = last
+                            .unwrap()
+                            .split_whitespace()
+                            .take(2)
+                            .map(|f| f.parse().unwrap())
+                            .collect();
+                        let (x, y) = (fields[0], fields[1]);
+                        let crossed = if gravity == "(0.0, 0.0)" {
+                            x > 5.0 && y.abs() < 5.0
+                        } else {
+                            y < 0.0 && x.abs() < 5.0
+                        };
+                        assert!(
+                            !crossed,
+                            "{solver}, radius {radius}, {speed} m/s into {segment}, {steps} \
+                             steps: ended at ({x}, {y})"
+                        );
+                    }
+                }
+            }
+        }
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
