@@ -174,7 +174,7 @@ fn a_ball_never_crosses_a_segment_wall_under_soft_at_any_speed() {
                         ];
                         successful(&args);
                         let text = std::fs::read_to_string(&dump).unwrap();
-                        let last = text.lines().filter(|l| !l.trim().is_empty()).last();
+                        let last = text.lines().rfind(|l| !l.trim().is_empty());
                         let fields: Vec<f64> = last
                             .unwrap()
                             .split_whitespace()
