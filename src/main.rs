@@ -52,23 +52,28 @@ enum Command {
         #[arg(long, value_name = "DIR", default_value = "out")]
         out: PathBuf,
         /// Disks in the box (65536 for the liquid-hexatic region).
-        #[arg(long, default_value_t = 4096)]
+        #[arg(long, default_value_t = 4096, allow_negative_numbers = true, value_parser = parse_count)]
         n: usize,
         /// Area fractions, comma-separated, each in (0, 0.85]. Default: 0.05 to 0.65 by 0.05,
         /// then 0.68, 0.70, 0.72.
-        #[arg(long, value_delimiter = ',', value_name = "ETA,...")]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            value_name = "ETA,...",
+            allow_negative_numbers = true
+        )]
         area_fractions: Option<Vec<f64>>,
         /// Collisions per disk run first and discarded (melting the lattice, equilibrating).
-        #[arg(long, default_value_t = 100.0)]
+        #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
         equilibrate: f64,
         /// Blocks measured after that.
-        #[arg(long, default_value_t = 10)]
+        #[arg(long, default_value_t = 10, allow_negative_numbers = true, value_parser = parse_count)]
         blocks: usize,
         /// Collisions per disk in each block.
-        #[arg(long, default_value_t = 100.0)]
+        #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
         block: f64,
         /// Seed of the velocities.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = parse_seed)]
         seed: u64,
     },
     /// Print the systems a scene schedules, one per line.
@@ -87,10 +92,10 @@ struct AppArgs {
     #[arg(long, value_name = "PATH")]
     scene: Option<PathBuf>,
     /// Number of random circles (overrides the scene).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_count)]
     count: Option<usize>,
     /// Seed of the random placement (overrides the scene).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
     seed: Option<u64>,
     /// Solver: `discrete`, `substeps=N`, `soft`, `soft=N`, `swept` or `exact` (overrides the
     /// scene).
@@ -124,22 +129,22 @@ struct RunArgs {
     solver: Option<SolverChoice>,
     /// With `--solver auto`: the largest acceptable error, as the larger of the position error
     /// against `exact` after a short calibration and the deepest overlap, both in radii.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     tolerance: Option<f64>,
     /// Boundary of a particle file's unit square: `walls`, `periodic` or `open`.
     #[arg(long)]
     boundary: Option<Boundary>,
     /// Fixed step in seconds, e.g. `0.01` or `1/60` (default: the scene's, or 1/60).
-    #[arg(long, value_parser = parse_dt)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_dt)]
     dt: Option<f64>,
     /// Simulated seconds to run (rounded up to whole steps).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seconds: Option<f64>,
     /// Fixed steps to run (from 1 to 10^10).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_STEPS))]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_steps)]
     steps: Option<u64>,
     /// Seed of the random placement (overrides the scene).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
     seed: Option<u64>,
     /// Where a scene's circles are spawned (overrides the scene): `random`; `lattice` (a
     /// triangular lattice of equal circles, up to area fraction ~0.88); or `pack` (any radii,
@@ -147,7 +152,7 @@ struct RunArgs {
     #[arg(long)]
     placement: Option<Placement>,
     /// Fill this area fraction with a scene's circles (overrides the scene's count).
-    #[arg(long, value_name = "PHI")]
+    #[arg(long, value_name = "PHI", allow_negative_numbers = true)]
     area_fraction: Option<f64>,
     /// Write the report (JSON) here.
     #[arg(long, value_name = "PATH.json")]
@@ -175,6 +180,29 @@ struct RunArgs {
     /// is bit for bit that of the run without the pause.
     #[arg(long, value_name = "PATH", conflicts_with_all = ["solver", "dt", "seed", "boundary", "tolerance", "placement", "area_fraction"])]
     resume: Option<PathBuf>,
+}
+
+/// A whole number from `lo` to `hi`, or the rule it breaks.
+fn whole(s: &str, lo: u64, hi: u64) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) if (lo..=hi).contains(&n) => Ok(n),
+        _ => Err(format!("must be a whole number from {lo} to {hi}, got {s}")),
+    }
+}
+
+/// A seed: any whole number that fits in 64 bits.
+fn parse_seed(s: &str) -> Result<u64, String> {
+    whole(s, 0, u64::MAX)
+}
+
+/// A number of steps, within [`MAX_STEPS`].
+fn parse_steps(s: &str) -> Result<u64, String> {
+    whole(s, 1, MAX_STEPS)
+}
+
+/// A number of circles (the scene's checks bound it further).
+fn parse_count(s: &str) -> Result<usize, String> {
+    whole(s, 0, usize::MAX as u64).map(|n| n as usize)
 }
 
 /// A step in seconds, as a number or a fraction (`1/60`), within [`DT_RANGE`].

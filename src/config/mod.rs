@@ -101,17 +101,25 @@ impl fmt::Display for Solver {
 
 /// Why a solver name could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "unknown solver `{0}`: expected `discrete`, `substeps=N` (N from 1 to {max}), `soft`, `soft=N`, `swept` or `exact`",
-    max = MAX_SUBSTEPS
-)]
-pub struct ParseSolverError(pub String);
+pub enum ParseSolverError {
+    /// Not one of the solvers' names.
+    #[error(
+        "unknown solver `{0}`: expected `discrete`, `substeps=N`, `soft`, `soft=N` (N from 1 to {max}), `swept` or `exact`",
+        max = MAX_SUBSTEPS
+    )]
+    Unknown(String),
+    /// `substeps=N` or `soft=N` with an `N` that is not a whole number in range.
+    #[error(
+        "the substeps in `substeps=N` and `soft=N` must be a whole number, N from 1 to {max}, got `{0}`",
+        max = MAX_SUBSTEPS
+    )]
+    Count(String),
+}
 
 impl FromStr for Solver {
     type Err = ParseSolverError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let err = || ParseSolverError(s.to_owned());
         match s.trim() {
             "discrete" => Ok(Self::Discrete),
             "swept" => Ok(Self::Swept),
@@ -121,11 +129,11 @@ impl FromStr for Solver {
                 let (make, n): (fn(u32) -> Self, _) = match other.split_once('=') {
                     Some(("substeps", n)) => (Self::Substeps, n),
                     Some(("soft", n)) => (Self::Soft, n),
-                    _ => return Err(err()),
+                    _ => return Err(ParseSolverError::Unknown(s.to_owned())),
                 };
-                match n.parse::<u32>() {
+                match n.trim().parse::<u32>() {
                     Ok(n) if (1..=MAX_SUBSTEPS).contains(&n) => Ok(make(n)),
-                    _ => Err(err()),
+                    _ => Err(ParseSolverError::Count(s.to_owned())),
                 }
             }
         }

@@ -275,3 +275,40 @@ fn the_command_line_fails_cleanly_on_bad_files_and_flags() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_flag_out_of_its_range_gets_the_flags_rule_not_the_parsers() {
+    // A negative number used to read as an unknown flag ("unexpected argument '-1'"), and an
+    // out-of-range solver count did not say the range.
+    let scene = ["run", "--scene", "assets/scenes/classic.ron"];
+    let cases: &[(&[&str], &str)] = &[
+        (&["--seconds", "-1"], "--seconds must be positive"),
+        (&["--steps", "1", "--dt", "-0.01"], "must be between"),
+        (&["--steps", "-5"], "from 1 to 10000000000"),
+        (&["--steps", "1", "--seed", "-1"], "whole number from 0 to"),
+        (
+            &["--steps", "1", "--solver", "auto", "--tolerance", "-1"],
+            "--tolerance must be a positive number, got -1",
+        ),
+        (&["--steps", "1", "--area-fraction", "-0.5"], "area"),
+        (
+            &["--steps", "1", "--solver", "soft=0"],
+            "N from 1 to 1024, got `soft=0`",
+        ),
+        (
+            &["--steps", "1", "--solver", "substeps=2000"],
+            "N from 1 to 1024, got `substeps=2000`",
+        ),
+        (&["--steps", "1", "--solver", "soft=-3"], "N from 1 to 1024"),
+    ];
+    for (flags, said) in cases {
+        let (ok, err) = cli(&[&scene[..], flags].concat());
+        assert!(!ok, "{flags:?} was accepted");
+        assert!(
+            err.contains(said) && !err.contains("unexpected argument"),
+            "{flags:?}: expected `{said}` in: {err}"
+        );
+    }
+    let (ok, err) = cli(&["eos", "--seed", "-2", "--n", "16"]);
+    assert!(!ok && err.contains("whole number from 0 to"), "{err}");
+}
