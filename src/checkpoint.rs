@@ -69,6 +69,9 @@ pub struct Checkpoint {
     /// What circles have of their own that code gave them (restitution, friction, inertia,
     /// layers, sensors), for those that have any.
     own: Vec<OwnParts>,
+    /// Circles dropped when the run began ([`Progress::drops_before`]; last, so that it was
+    /// added to the layout at its end).
+    drops_before: usize,
 }
 
 impl Checkpoint {
@@ -140,6 +143,7 @@ impl Checkpoint {
             engine,
             contacts,
             own,
+            drops_before: progress.drops_before,
         }
     }
 
@@ -233,6 +237,12 @@ impl Checkpoint {
             if !self.arena.is_open() && !self.arena.contains(c.position) {
                 return Err(format!("circle {i} at {} is outside the arena", c.position));
             }
+        }
+        if self.drops_before > self.dropped {
+            return Err(format!(
+                "{} circles dropped when the run began, more than the {} dropped since",
+                self.drops_before, self.dropped
+            ));
         }
         let p = &self.progress;
         let numbers = [
@@ -354,7 +364,11 @@ impl Checkpoint {
                 .restore(engine, &circles, setup)
                 .map_err(|message| InputError::whole(origin, message))?;
         }
-        Ok((app, self.progress))
+        let progress = Progress {
+            drops_before: self.drops_before,
+            ..self.progress
+        };
+        Ok((app, progress))
     }
 }
 

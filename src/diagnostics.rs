@@ -12,9 +12,9 @@ use crate::boundary::WallCollisions;
 use crate::circle::inertia;
 use crate::collide::PairCollisions;
 use crate::components::{AngularVelocity, Inertia, Mass, Position, Radius, Velocity};
-use crate::config::Effects;
+use crate::config::{DropConfig, Effects, SpawnConfig};
 use crate::schedule::{CircleSystems, StepTotals};
-use crate::spawn::SpawnReport;
+use crate::spawn::{Dropped, SpawnReport, nth_drop};
 
 /// Pressure as the compressibility factor `z = P·A / (N·kT)`, with `kT` the mean kinetic energy
 /// per circle (2D), measured two ways over the time since the last reset.
@@ -83,6 +83,8 @@ pub struct CircleDiagnostics {
     pub energy: f64,
     /// Mechanical energy right after the last (re)spawn.
     pub initial_energy: f64,
+    /// Mechanical energy the circles dropped since then brought in as they entered.
+    pub added_energy: f64,
     /// Centres outside the arena.
     pub escaped: usize,
     /// Total momentum `Σ m v`.
@@ -94,10 +96,11 @@ pub struct CircleDiagnostics {
 }
 
 impl CircleDiagnostics {
-    /// Relative change of the mechanical energy since the last reset: `(E - E0) / |E0|`, or the
-    /// absolute change when `E0` is zero or all but zero (so it is always finite).
+    /// Relative change of the mechanical energy since the last reset, counting what drops
+    /// brought in: `(E - E0 - Ed) / |E0 + Ed|`, or the absolute change when `E0 + Ed` is zero or
+    /// all but zero (so it is always finite).
     pub fn energy_drift(&self) -> f64 {
-        relative_change(self.initial_energy, self.energy)
+        relative_change(self.initial_energy + self.added_energy, self.energy)
     }
 }
 
@@ -176,6 +179,36 @@ impl Totals {
     }
 }
 
+/// Energy and momentum the drops numbered `drops` brought in as they entered, in `arena` under
+/// `gravity` with the spawn rules' mass model: what a run's energy and momentum gained from
+/// outside.
+pub fn drops_brought(
+    rules: &DropConfig,
+    drops: std::ops::Range<usize>,
+    (spawn, arena, gravity): (&SpawnConfig, &Arena, Option<DVec2>),
+) -> Totals {
+    let circles = drops.map(|k| {
+        let c = nth_drop(rules, spawn, k);
+        (c.position, c.velocity, c.mass, (0.0, 0.0))
+    });
+    Totals::measure(circles, arena, gravity)
+}
+
+/// Energy and momentum the circles dropped since the `from`-th brought in as they entered
+/// (zero without drop rules).
+pub fn dropped_totals(world: &World, from: usize) -> Totals {
+    let rules = world.get_resource::<DropConfig>();
+    let dropped = world.get_resource::<Dropped>().map_or(0, |d| d.count);
+    let setting = (
+        world.resource::<SpawnConfig>(),
+        world.resource::<Arena>(),
+        world.resource::<Effects>().gravity,
+    );
+    rules.map_or_else(Totals::default, |rules| {
+        drops_brought(rules, from..dropped, setting)
+    })
+}
+
 /// When [`CircleDiagnostics`] is measured. Measuring reads every circle, so a headless run that
 /// takes its own totals (`run::advance`) turns it to [`Measuring::AfterSpawn`] while it steps:
 /// its timed steps then pay for nothing nobody reads.
@@ -230,12 +263,20 @@ type MeasuredCircles<'w, 's> = Query<
     ),
 >;
 
-/// Updates [`CircleDiagnostics`] from the circles.
+/// The drop rules and how far they got, where a scene has them.
+type Drops<'w> = (
+    Option<Res<'w, DropConfig>>,
+    Option<Res<'w, Dropped>>,
+    Option<Res<'w, SpawnConfig>>,
+);
+
+/// Updates [`CircleDiagnostics`] from the circles (and the drops so far).
 fn measure(
     arena: Res<Arena>,
     effects: Res<Effects>,
     mut diagnostics: ResMut<CircleDiagnostics>,
     circles: MeasuredCircles,
+    (rules, dropped, spawn): Drops,
 ) {
     let spin = |w: Option<&AngularVelocity>| w.map_or(0.0, |w| w.0);
     let totals = Totals::measure(
@@ -249,6 +290,15 @@ fn measure(
     diagnostics.count = totals.count;
     diagnostics.kinetic_energy = totals.kinetic_energy;
     diagnostics.energy = totals.energy();
+    diagnostics.added_energy = match (rules, dropped, spawn) {
+        (Some(rules), Some(dropped), Some(spawn))
+            if dropped.generation == diagnostics.generation =>
+        {
+            let setting = (spawn.as_ref(), arena.as_ref(), effects.gravity);
+            drops_brought(&rules, 0..dropped.count, setting).energy()
+        }
+        _ => 0.0,
+    };
     diagnostics.momentum = totals.momentum;
     diagnostics.non_finite = totals.non_finite;
     diagnostics.escaped = totals.escaped;

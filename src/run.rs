@@ -20,13 +20,13 @@ use crate::collide::overlaps::Overlaps;
 use crate::collision_layers::{LayeredDisc, layered_disc};
 use crate::components::{Inertia, Sleep};
 use crate::config::{CirclesConfig, Effects, Solver};
-use crate::diagnostics::{Measuring, Pressure, Totals, relative_change};
+use crate::diagnostics::{Measuring, Pressure, Totals, dropped_totals, relative_change};
 use crate::effects::{Effect, EffectRegistry};
 use crate::error::FieldError;
 use crate::exact::EngineState;
 use crate::scene::check::check_motion;
 use crate::schedule::StepTotals;
-use crate::spawn::SpawnReport;
+use crate::spawn::{Dropped, SpawnReport};
 
 /// A headless app for `config`, past `Startup` (circles spawned), in which every `update()`
 /// advances exactly one fixed step.
@@ -117,6 +117,11 @@ pub fn run_steps(
 pub struct Progress {
     /// Energy, momentum and counts when the run began.
     pub before: Totals,
+    /// Circles the scene's drop rules had dropped when the run began: those dropped after
+    /// bring their energy and momentum into the run ([`dropped_totals`]). Kept in checkpoints
+    /// as their last field.
+    #[serde(skip)]
+    pub drops_before: usize,
     /// Overlaps seen in the samples so far.
     pub overlaps: Overlaps,
     /// Wall-clock time spent stepping so far.
@@ -133,6 +138,7 @@ impl Progress {
     pub fn start(world: &mut World) -> Self {
         Self {
             before: totals(world),
+            drops_before: world.resource::<Dropped>().count,
             ..Self::default()
         }
     }
@@ -266,17 +272,24 @@ pub struct Report {
     pub ms_per_step: f64,
     /// Mechanical energy (kinetic, plus potential under gravity) at the start.
     pub energy_initial: f64,
+    /// Mechanical energy the circles dropped during the run brought in as they entered (0
+    /// without drop rules).
+    pub energy_added: f64,
     /// Mechanical energy at the end.
     pub energy_final: f64,
-    /// `(final - initial) / |initial|`, or the absolute change when the initial energy is 0 or
-    /// so small that the ratio overflows.
+    /// `(final - expected) / |expected|` with `expected = initial + added`, or the absolute
+    /// change when the expected energy is 0 or so small that the ratio overflows.
     pub energy_drift: f64,
     /// Total momentum `[x, y]` at the start.
     pub momentum_initial: [f64; 2],
+    /// Momentum the dropped circles brought in.
+    pub momentum_added: [f64; 2],
     /// Total momentum at the end.
     pub momentum_final: [f64; 2],
     /// Angular momentum about the origin at the start, `Σ (m x × v + I ω)`.
     pub angular_momentum_initial: f64,
+    /// Angular momentum the dropped circles brought in.
+    pub angular_momentum_added: f64,
     /// The same at the end.
     pub angular_momentum_final: f64,
     /// Deepest overlap after any (sampled) step, as a fraction of the pair's smaller radius.
@@ -317,10 +330,14 @@ impl Report {
         let numbers = [
             self.sim_seconds,
             self.energy_initial,
+            self.energy_added,
             self.energy_final,
             self.energy_drift,
             self.momentum_initial[0],
             self.momentum_initial[1],
+            self.momentum_added[0],
+            self.momentum_added[1],
+            self.angular_momentum_added,
             self.momentum_final[0],
             self.momentum_final[1],
             self.angular_momentum_initial,
@@ -341,6 +358,7 @@ impl Report {
         let after = totals(world);
         let Progress {
             before,
+            drops_before,
             overlaps,
             stepping,
             ..
@@ -368,6 +386,8 @@ impl Report {
             &arena,
         );
         let wall_seconds = stepping.as_secs_f64();
+        let added = dropped_totals(world, drops_before);
+        let expected = before.energy() + added.energy();
         Report {
             source: source.to_owned(),
             n: after.count,
@@ -390,10 +410,13 @@ impl Report {
             },
             energy_initial: before.energy(),
             energy_final: after.energy(),
-            energy_drift: relative_change(before.energy(), after.energy()),
+            energy_added: added.energy(),
+            energy_drift: relative_change(expected, after.energy()),
             momentum_initial: before.momentum.to_array(),
+            momentum_added: added.momentum.to_array(),
             momentum_final: after.momentum.to_array(),
             angular_momentum_initial: before.angular_momentum,
+            angular_momentum_added: added.angular_momentum,
             angular_momentum_final: after.angular_momentum,
             max_penetration: overlaps.max,
             mean_penetration: overlaps.mean(),

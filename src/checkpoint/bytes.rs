@@ -10,7 +10,7 @@ use crate::error::InputError;
 use crate::io::read_bytes_limited;
 
 /// The first field of every checkpoint: what it is and the layout's version.
-pub(super) const FORMAT: &str = "moving_circles checkpoint 9";
+pub(super) const FORMAT: &str = "moving_circles checkpoint 10";
 /// What ends a checkpoint: the CRC-32 (IEEE) of every byte before it, little-endian.
 pub(super) const CHECKSUM_BYTES: usize = 4;
 /// Bytes read before the format is checked: any format name of ours, with its length, fits.

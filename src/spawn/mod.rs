@@ -187,11 +187,8 @@ fn drop_circles(
     if dropped.count >= config.count || totals.sim_seconds + 1e-9 * config.every < due {
         return;
     }
-    // One random stream per drop: a drop that waits tries the same spot again.
-    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
-    rng.set_stream(dropped.count as u64);
-    let dx = sample_between(&mut rng, -config.spread, config.spread);
-    let (p, r) = (config.position + DVec2::new(dx, 0.0), config.radius);
+    let circle = nth_drop(&config, &spawn, dropped.count);
+    let (p, r) = (circle.position, circle.radius);
     let taken = circles
         .iter()
         .any(|(q, s)| p.distance_squared(q.0) < (r + s.0) * (r + s.0));
@@ -199,17 +196,26 @@ fn drop_circles(
     if taken || walled {
         return;
     }
-    let circle = CircleState {
-        position: p,
+    commands.spawn(circle.bundle());
+    dropped.count += 1;
+}
+
+/// The `k`-th circle `config` drops (from 0), as it enters: where, how fast, how heavy. Each
+/// drop has its own random stream, so a drop that waits for its spot tries the same spot again,
+/// and what the drops brought in can be counted afterwards from their number alone.
+pub fn nth_drop(config: &DropConfig, spawn: &SpawnConfig, k: usize) -> CircleState {
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    rng.set_stream(k as u64);
+    let dx = sample_between(&mut rng, -config.spread, config.spread);
+    CircleState {
+        position: config.position + DVec2::new(dx, 0.0),
         velocity: config.velocity,
-        radius: r,
-        mass: spawn.mass.mass_of(r),
+        radius: config.radius,
+        mass: spawn.mass.mass_of(config.radius),
         tint: hue_to_rgb(rng.random_range(0.0..1.0)),
         angular_velocity: 0.0,
         rotation: 0.0,
-    };
-    commands.spawn(circle.bundle());
-    dropped.count += 1;
+    }
 }
 
 /// Despawns every circle and places a fresh set.

@@ -13,6 +13,7 @@ mod collision_layers;
 mod collisions;
 mod dense;
 mod docs_links;
+mod drops;
 mod effects;
 mod eos;
 mod event_reference;

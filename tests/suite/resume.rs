@@ -122,7 +122,8 @@ fn a_checkpoint_that_is_damaged_or_not_one_is_refused_by_name() {
     longer.push(b'\n');
     // Everything after the format's name at its largest: every length and count it reads
     // claims more than memory holds (its checksum made to match, so that the fields are read).
-    let header = b"\x1bmoving_circles checkpoint ".len() + 1;
+    // (The name is a string: its length in one byte, then its bytes.)
+    let header = 1 + usize::from(good[0]);
     let mut largest = good.clone();
     largest[header..].fill(0xff);
     moving_circles::checkpoint::Checkpoint::reseal(&mut largest);

@@ -3,18 +3,11 @@
 //! once lost a third to four fifths of it; and settings too soft to hold a heap are never
 //! silent.
 
-use crate::common::binary::{scratch_dir, stderr, successful};
+use crate::common::binary::{run_report, scratch_dir, stderr, successful};
 
-/// Runs `moving_circles run` with `args` and a report in a scratch folder; the report.
+/// Runs `moving_circles run` with `args`; its report.
 fn report(name: &str, args: &[&str]) -> serde_json::Value {
-    let dir = scratch_dir("soft_promises", name);
-    let path = dir.join("r.json");
-    let mut args = args.to_vec();
-    args.extend(["--report", path.to_str().unwrap()]);
-    successful(&args);
-    let json = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    std::fs::remove_dir_all(dir).unwrap();
-    json
+    run_report("soft_promises", name, args)
 }
 
 fn drift(report: &serde_json::Value) -> f64 {

@@ -52,6 +52,25 @@ pub fn scratch_dir(file: &str, name: &str) -> PathBuf {
     dir
 }
 
+/// Runs `moving_circles run` with `args` and `--report` into a scratch folder of the test
+/// `name` of the test file `file`, asserting it succeeded; the report.
+pub fn run_report(file: &str, name: &str, args: &[&str]) -> serde_json::Value {
+    let dir = scratch_dir(file, name);
+    let path = dir.join("r.json");
+    let mut args = args.to_vec();
+    args.extend(["--report", path.to_str().unwrap()]);
+    successful(&args);
+    let json = read_report(&path);
+    std::fs::remove_dir_all(dir).unwrap();
+    json
+}
+
+/// The JSON report at `path`.
+pub fn read_report(path: &std::path::Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).expect("report written");
+    serde_json::from_str(&text).expect("a JSON report")
+}
+
 /// What the run wrote to stderr.
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
