@@ -65,8 +65,8 @@ impl EventEngine {
         if wa == 0.0 && self.motion[i].vel == DVec2::ZERO {
             self.rest_on_support(j, -n, e);
         }
-        self.sleep_if_jammed(i);
-        self.sleep_if_jammed(j);
+        self.sleep_if_jammed(i, e);
+        self.sleep_if_jammed(j, e);
         self.counter[i] += 1;
         self.counter[j] += 1;
         self.predict(i);

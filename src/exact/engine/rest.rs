@@ -87,9 +87,23 @@ impl EventEngine {
         if elastic { 1.0 } else { e }
     }
 
-    /// Puts circle `i` to sleep if it is jammed ([`JAM_HITS`] quick hits in a row).
-    pub(super) fn sleep_if_jammed(&mut self, i: usize) {
-        if self.falls[i] && self.quick_hits[i] >= JAM_HITS {
+    /// Puts circle `i` to sleep if it is jammed: [`JAM_HITS`] quick hits in a row, the last at
+    /// restitution `e`, without going anywhere (within [`RESTING_DRIFT`] of its radius of one
+    /// place; at `e = 1`, where stopping it must lose no more than rounding, all but still:
+    /// slower than a fall of [`ROUNDING_HEIGHT`] of its radius gives). Quick hits alone are no
+    /// jam: the contact time grows as `√(r/g)`, so under weak gravity every hit of a gas is
+    /// quick, and a circle in flight put to sleep takes its energy with it.
+    pub(super) fn sleep_if_jammed(&mut self, i: usize, e: f64) {
+        if !self.falls[i] || self.quick_hits[i] < JAM_HITS {
+            return;
+        }
+        let jammed = if e < 1.0 {
+            self.near_anchor(i)
+        } else {
+            let m = &self.motion[i];
+            m.vel.length_squared() < 2.0 * self.gravity.length() * ROUNDING_HEIGHT * m.radius
+        };
+        if jammed {
             self.fall_asleep(i);
         }
     }
@@ -182,15 +196,20 @@ impl EventEngine {
 
     /// Whether circle `i`, bouncing its least bounce, has stayed within [`RESTING_DRIFT`] of its
     /// radius of one place for [`RESTING_TIME`]: held by circles that are awake themselves (two
-    /// leaning on each other), it rests all the same. Moves its anchor when it has not.
+    /// leaning on each other), it rests all the same.
     fn stayed(&mut self, i: usize) -> bool {
+        self.near_anchor(i) && self.now - self.anchor[i].1 >= RESTING_TIME
+    }
+
+    /// Whether circle `i` is within [`RESTING_DRIFT`] of its radius of its anchor, the place it
+    /// has stayed near since the anchor's time; if not, the anchor moves to where it is now.
+    fn near_anchor(&mut self, i: usize) -> bool {
         let (p, r) = (self.motion[i].pos, self.motion[i].radius);
-        let (anchor, since) = self.anchor[i];
-        if self.offset(anchor, p).length() > RESTING_DRIFT * r {
+        if self.offset(self.anchor[i].0, p).length() > RESTING_DRIFT * r {
             self.anchor[i] = (p, self.now);
             return false;
         }
-        self.now - since >= RESTING_TIME
+        true
     }
 
     /// Whether circle `i`'s supports hold it against gravity: a support right under it, or two

@@ -48,7 +48,7 @@ impl EventEngine {
         normal[axis] = if high { 1.0 } else { -1.0 };
         self.rough_wall(i, normal);
         self.rest_on_support(i, normal, e);
-        self.sleep_if_jammed(i);
+        self.sleep_if_jammed(i, e);
         let impulse = self.count_wall_hit(i, (new_v - v).abs());
         if let Some(log) = &mut self.hits {
             let wall = ArenaWall::on_axis(axis, high);
@@ -131,7 +131,7 @@ impl EventEngine {
         }
         // Pressed against the wall by gravity with no speed, or bounced off it weakly: rest.
         self.rest_on_support(i, -out, e);
-        self.sleep_if_jammed(i);
+        self.sleep_if_jammed(i, e);
         self.counter[i] += 1;
         self.predict(i);
     }
