@@ -234,9 +234,61 @@ impl CirclesConfig {
             drop.check(&self.arena, self.spawn.mass)
                 .map_err(|e| e.within("drop"))?;
         }
-        self.spawn.check(&self.arena).map_err(|e| e.within("spawn"))
+        self.spawn
+            .check(&self.arena)
+            .map_err(|e| e.within("spawn"))?;
+        self.check_gravity_scale()
+    }
+
+    /// The smallest radius of a circle that moves: of the random circles (if any are placed),
+    /// the explicit ones and the dropped ones; `None` if none moves.
+    pub fn least_moving_radius(&self) -> Option<f64> {
+        let placed = self.spawn.count > 0 || self.spawn.area_fraction.is_some();
+        let random = placed.then_some(self.spawn.radius.0);
+        let explicit = self
+            .circles
+            .iter()
+            .filter(|c| c.mass.is_finite())
+            .map(|c| c.radius);
+        let dropped = self.drop.map(|d| d.radius);
+        random
+            .into_iter()
+            .chain(explicit)
+            .chain(dropped)
+            .reduce(f64::min)
+    }
+
+    /// Whether gravity is weak enough for the step and the circles: a circle of the least
+    /// radius `r` falls its own radius in about `√(r/g)`, and a step of more than
+    /// [`MAX_FALLS_PER_STEP`] of those is refused. The event solvers' work per step grows with
+    /// that number (a circle bouncing on a floor), and past it rounding in their event times
+    /// reaches the energy; the time-stepped solvers move a circle half a million radii a step
+    /// there.
+    pub fn check_gravity_scale(&self) -> Result<(), FieldError> {
+        let (Some(g), Some(r)) = (self.effects.gravity, self.least_moving_radius()) else {
+            return Ok(());
+        };
+        let falls = self.dt * (g.length() / r).sqrt();
+        if falls <= MAX_FALLS_PER_STEP {
+            return Ok(());
+        }
+        let limit = r * (MAX_FALLS_PER_STEP / self.dt).powi(2);
+        Err(FieldError::new(
+            "effects.gravity",
+            format!(
+                "|g| = {:e} is too strong for a step of {} s and circles of radius {r}: one would \
+                 fall its radius {falls:.0} times a step, at most {MAX_FALLS_PER_STEP}; here \
+                 |g| may be at most {limit:.3e} (a shorter dt or larger circles allow more)",
+                g.length(),
+                self.dt
+            ),
+        ))
     }
 }
+
+/// Most times a circle of the least radius may fall its own radius (`√(r/g)`) in one step
+/// ([`CirclesConfig::check`]).
+pub const MAX_FALLS_PER_STEP: f64 = 1000.0;
 
 #[cfg(test)]
 mod tests {

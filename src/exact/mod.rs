@@ -51,8 +51,15 @@ pub const SWEPT_EVENTS_PER_CIRCLE: u64 = 64;
 /// that cross the arena millions of times a step (the default of [`EventBudget::exact`]).
 pub const EXACT_EVENTS_PER_CIRCLE: u64 = 100_000;
 
-/// How many events a `swept` or `exact` step may process, per circle (and one circle more),
-/// before the rest of the step is free flight (counted in
+/// Events per circle a `swept` step may process, at least, per fall of the least radius
+/// (`√(r/g)`, [`EventEngine::falls_in`](engine::EventEngine::falls_in)): under strong gravity
+/// its circles bounce about that often, and its own bound ([`SWEPT_EVENTS_PER_CIRCLE`]) would
+/// cut the step short (`exact`'s is far above what any gravity a scene may have needs).
+pub const GRAVITY_EVENTS_PER_FALL: f64 = 8.0;
+
+/// How many events a `swept` or `exact` step may process, per circle (and one circle more;
+/// under strong gravity more for `swept`, [`GRAVITY_EVENTS_PER_FALL`]), before the rest of the
+/// step is free flight (counted in
 /// [`EngineState::budget_exhausted`]). A game that must bound the work of a frame lowers
 /// `exact`'s; the collisions it skips then show as overlapping, approaching pairs, resolved
 /// next step.
@@ -75,10 +82,13 @@ impl Default for EventBudget {
 }
 
 impl EventBudget {
-    /// The events a step of `solver` may process with `circles` circles.
-    pub fn for_step(&self, solver: Solver, circles: usize) -> u64 {
+    /// The events a step of `solver` may process with `circles` circles, the least of which
+    /// falls its radius `falls` times in the step ([`GRAVITY_EVENTS_PER_FALL`]).
+    pub fn for_step(&self, solver: Solver, circles: usize, falls: f64) -> u64 {
         let per_circle = match solver {
-            Solver::Swept => self.swept,
+            Solver::Swept => self
+                .swept
+                .max((GRAVITY_EVENTS_PER_FALL * falls).ceil() as u64),
             _ => self.exact,
         };
         per_circle.saturating_mul(circles as u64 + 1)
@@ -311,7 +321,7 @@ fn advance_engine(
     let Some(engine) = state.engine.as_mut() else {
         return;
     };
-    let budget = budget.for_step(solver, engine.len());
+    let budget = budget.for_step(solver, engine.len(), engine.falls_in(dt));
 
     let t_start = engine.now();
     let t_end = t_start + dt;

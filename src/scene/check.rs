@@ -115,6 +115,8 @@ impl Scene {
             check_circle(&circle, &arena).map_err(within)?;
             config.circles.push(circle);
         }
+        // With its explicit circles in, gravity is checked against them too.
+        config.check_gravity_scale().map_err(field_error)?;
         if self.separate_overlaps {
             check_separable(&config.circles, &arena).map_err(field_error)?;
             separate_overlaps(&mut config.circles, &arena);

@@ -294,6 +294,11 @@ fn one_physical_range_for_every_value_of_every_input() {
             "(circles: [(position: (0.0, 0.0), velocity: (1e155, 0.0), radius: 0.1)])",
             "field `circles[0].velocity`",
         ),
+        // Gravity within the range but too strong for the step and the circles.
+        (
+            "(effects: (gravity: (0.0, -1e30)), circles: [(position: (0.0, 0.0), radius: 0.1)])",
+            "field `effects.gravity`: |g| = 1e30 is too strong",
+        ),
     ];
     for (k, (text, expected)) in scenes.iter().enumerate() {
         let path = dir.join(format!("s{k}.ron"));
@@ -326,7 +331,7 @@ fn one_physical_range_for_every_value_of_every_input() {
     std::fs::write(
         &path,
         "(arena: (size: (1e-3, 1e-3)), mass: Equal(1e30), \
-          effects: (gravity: (0.0, -1e30), restitution: 0.5, wall_restitution: 0.5), \
+          effects: (gravity: (0.0, -3.6e4), restitution: 0.5, wall_restitution: 0.5), \
           spawn: (count: 20, radius: (1e-5, 2e-5), speed: (1e30, 1e30)))",
     )
     .unwrap();

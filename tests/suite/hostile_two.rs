@@ -331,15 +331,18 @@ fn a_state_past_the_range_of_values_is_not_written_as_what_our_readers_refuse() 
 
 #[test]
 fn a_run_that_leaves_the_range_of_values_stops_at_the_first_sample_past_it() {
-    // Found trying the command as a user would: a pull and a drag of 10³⁰ take the circles
-    // past the range within a minute's step, and the run went on to its end (seconds a step
-    // at speeds past 10³⁰ under the event-driven solvers) only to write nothing. It stops at the sample that
-    // shows it, says which step, and writes nothing.
+    // Found trying the command as a user would: a pull and a drag of 10³⁰ took the circles
+    // past the range within a minute's step (such a pull is now refused up front), and the
+    // run went on to its end (seconds a step at speeds past 10³⁰ under the event-driven
+    // solvers) only to write nothing. Here a heavy circle at 10³⁰ m/s throws a light one past
+    // it. The run stops at the sample that shows it, says which step, and writes nothing.
     let dir = temp_dir("leaves-range");
     let scene = dir.join("s.ron");
     std::fs::write(
         &scene,
-        "(effects: (gravity: (0.0, -1e30), drag: 1e30), spawn: (count: 50, seed: 2))",
+        "(effects: (restitution: 1.0), circles: [ \
+           (position: (-2.0, 0.0), velocity: (1e30, 0.0), radius: 0.5, mass: 1e6), \
+           (position: (2.0, 0.0), radius: 0.1, mass: 1e-6)])",
     )
     .unwrap();
     let report = dir.join("r.json");

@@ -17,6 +17,7 @@ mod drops;
 mod effects;
 mod eos;
 mod event_reference;
+mod exact_promises;
 mod friction;
 mod galton;
 mod game_changes;

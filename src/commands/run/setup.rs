@@ -8,6 +8,7 @@ use bevy::prelude::App;
 use super::options::{Input, Length, MAX_STEPS, RunOptions, SolverChoice};
 use crate::accuracy::auto::choose_solver;
 use crate::config::{CirclesConfig, Placement, Solver};
+use crate::error::InputError;
 use crate::io::{check_output_path, same_output};
 use crate::run::headless_app_with;
 use crate::scene::{Scene, particles};
@@ -45,7 +46,9 @@ pub(super) fn configure(
         config.spawn.area_fraction = Some(fraction);
     }
     // The overrides go through the same check as the file did.
-    config.check()?;
+    config
+        .check()
+        .map_err(|e| InputError::from_field(&source, e))?;
     if options.seed.is_some() && config.spawn.target_count(&config.arena) == 0 {
         bail!("--seed places a scene's random circles, and {source} has none (`spawn.count` 0)");
     }

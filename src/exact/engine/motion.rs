@@ -13,6 +13,23 @@ use crate::arena::minimum_image;
 use crate::boundary::reflect_off_walls;
 
 impl EventEngine {
+    /// How many times the smallest circle that moves falls its own radius (`√(r/g)`) in
+    /// `span` seconds: under strong gravity, about how often each circle bounces (0 without
+    /// gravity or moving circles).
+    pub fn falls_in(&self, span: f64) -> f64 {
+        let least = self
+            .motion
+            .iter()
+            .zip(&self.inv_mass)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(m, _)| m.radius)
+            .reduce(f64::min);
+        match least {
+            Some(r) if self.gravity != DVec2::ZERO => span * (self.gravity.length() / r).sqrt(),
+            _ => 0.0,
+        }
+    }
+
     /// Where circle `i` is at time `t` on its current course (not wrapped).
     #[inline]
     pub(super) fn pos_at(&self, i: usize, t: f64) -> DVec2 {
