@@ -11,7 +11,10 @@ use crate::segment::Segment;
 /// A pair that is approaching (`dp·dv < 0`) and already overlaps by rounding (`|dp| < σ`)
 /// collides now (`Some(0)`); a pair that is separating never does, whatever its overlap.
 /// The root is taken in the form `c / (-b + √disc)`, which does not cancel when the pair is
-/// far apart and fast.
+/// far apart and fast, and the discriminant `b² - a·c` as `|dv|²σ² - (dp × dv)²` (Lagrange's
+/// identity), which does not cancel either: for a pair far apart the two squares of the first
+/// form are nearly equal (a pair 23 378 apart closing at 157 680, σ = 0.0029, lost 15 of its 16
+/// digits and met 2e-10 of the offset off contact).
 pub fn pair_time_of_impact(dp: DVec2, dv: DVec2, sigma: f64) -> Option<f64> {
     let b = dp.dot(dv);
     if b >= 0.0 {
@@ -22,7 +25,8 @@ pub fn pair_time_of_impact(dp: DVec2, dv: DVec2, sigma: f64) -> Option<f64> {
     if c <= 0.0 {
         return Some(0.0); // touching or overlapped by rounding, and approaching
     }
-    let disc = b * b - a * c;
+    let cross = dp.perp_dot(dv);
+    let disc = a * (sigma * sigma) - cross * cross;
     if disc < 0.0 {
         return None; // closest approach misses
     }
@@ -47,6 +51,9 @@ pub fn pair_time_of_impact(dp: DVec2, dv: DVec2, sigma: f64) -> Option<f64> {
 /// assert_eq!(t, Some(4.0));
 /// ```
 pub fn growing_pair_time_of_impact(dp: DVec2, dv: DVec2, sigma: f64, gamma: f64) -> Option<f64> {
+    if gamma == 0.0 {
+        return pair_time_of_impact(dp, dv, sigma);
+    }
     // |dp + dv·τ|² - (σ + γτ)² = aτ² + 2bτ + c.
     let b = dp.dot(dv) - sigma * gamma;
     let a = dv.length_squared() - gamma * gamma;

@@ -51,29 +51,31 @@ fn state_hash(dump: &Path) -> u64 {
 }
 
 /// `(scene, solver, hash of the state after 600 steps)`, measured on the code before the
-/// restructuring of the module layout.
+/// restructuring of the module layout. Those of `swept`, `exact` and `soft` changed when the time
+/// of impact came to take its discriminant by Lagrange's identity (`|dv|²σ² - (dp × dv)²`, which
+/// does not cancel for pairs far apart; a last-bits change, chaos does the rest).
 const PINNED_STATES: [(&str, &str, u64); 17] = [
     ("classic", "discrete", 0x70ec138773ba3976),
     ("classic", "substeps=4", 0x9b10061497aa709f),
-    ("classic", "swept", 0x556f37379ce5da07),
-    ("classic", "exact", 0x1ee4bcd1fdd602ce),
+    ("classic", "swept", 0xb2857781e71dfd7c),
+    ("classic", "exact", 0x0606ed7adecc5695),
     ("gas1k", "discrete", 0x23cf5270c00747ab),
     ("gas1k", "substeps=4", 0x4fd76996d41ba8e5),
-    ("gas1k", "swept", 0x226b06ee557f1608),
-    ("gas1k", "exact", 0xc6f0c2da6aed695e),
+    ("gas1k", "swept", 0x66b0606c0291b727),
+    ("gas1k", "exact", 0x5d1372630e101948),
     ("billiards", "discrete", 0x69534087135c38f7),
     ("billiards", "substeps=4", 0xe84ae06dacd1b120),
     ("billiards", "swept", 0x3ab6ee437c031ddf),
-    ("billiards", "exact", 0x169830d0d1ca1d8c),
+    ("billiards", "exact", 0xa46ca0377ac608ed),
     // `soft`, frictionless: measured when a step's bounces came to be solved together, with no
     // threshold without gravity and from the speed after the fall under it, and a contact whose
     // sides part (or, without gravity, still close) at the step's end came to be a new hit at its
     // next approach, and a bounce no longer warm starts the next step.
-    ("classic", "soft", 0x29d7018e5c44236e),
-    ("gas1k", "soft", 0xa8da1f149b7cee39),
+    ("classic", "soft", 0xe879e8d12fab8f10),
+    ("gas1k", "soft", 0xfe17447ff446594e),
     ("billiards", "soft", 0xb25beb7a43ada38f),
-    ("pile", "soft", 0xf58d4ee8557f98fa),
-    ("galton", "soft", 0x028e00a81ccb5d89),
+    ("pile", "soft", 0x2d9ae850967e82d4),
+    ("galton", "soft", 0x001da292af210fa3),
 ];
 
 #[test]
@@ -111,15 +113,16 @@ fn the_final_states_of_600_steps_are_unchanged_bit_for_bit() {
 }
 
 /// `(scene, solver, pair collisions)` of `accuracy --quick` (60 Hz), measured on the code before
-/// the restructuring of the module layout (`soft` and `soft=8` when they joined the study).
+/// the restructuring of the module layout (`soft` and `soft=8` when they joined the study; `soft`, `swept`
+/// and `exact` again when the time of impact took its discriminant by Lagrange's identity).
 const PINNED_COLLISIONS: [(&str, &str, u64); 36] = [
     ("gas1k", "discrete", 6813),
     ("gas1k", "substeps=2", 7152),
     ("gas1k", "substeps=4", 7367),
     ("gas1k", "substeps=8", 7480),
     ("gas1k", "substeps=16", 7495),
-    ("gas1k", "soft", 7373),
-    ("gas1k", "soft=8", 7286),
+    ("gas1k", "soft", 7327),
+    ("gas1k", "soft=8", 7267),
     ("gas1k", "swept", 7484),
     ("gas1k", "exact", 7484),
     ("gas", "discrete", 33818),
@@ -127,8 +130,8 @@ const PINNED_COLLISIONS: [(&str, &str, u64); 36] = [
     ("gas", "substeps=4", 36876),
     ("gas", "substeps=8", 37331),
     ("gas", "substeps=16", 37411),
-    ("gas", "soft", 36432),
-    ("gas", "soft=8", 36064),
+    ("gas", "soft", 36437),
+    ("gas", "soft=8", 36069),
     ("gas", "swept", 37505),
     ("gas", "exact", 37505),
     ("billiards", "discrete", 44),
@@ -137,7 +140,7 @@ const PINNED_COLLISIONS: [(&str, &str, u64); 36] = [
     ("billiards", "substeps=8", 29),
     ("billiards", "substeps=16", 28),
     ("billiards", "soft", 64),
-    ("billiards", "soft=8", 68),
+    ("billiards", "soft=8", 69),
     ("billiards", "swept", 30),
     ("billiards", "exact", 36),
     ("fast", "discrete", 651),
@@ -145,10 +148,10 @@ const PINNED_COLLISIONS: [(&str, &str, u64); 36] = [
     ("fast", "substeps=4", 2278),
     ("fast", "substeps=8", 3285),
     ("fast", "substeps=16", 3606),
-    ("fast", "soft", 3691),
-    ("fast", "soft=8", 3635),
-    ("fast", "swept", 3778),
-    ("fast", "exact", 3733),
+    ("fast", "soft", 3674),
+    ("fast", "soft=8", 3640),
+    ("fast", "swept", 3783),
+    ("fast", "exact", 3741),
 ];
 
 /// The same for the rough gas, measured when it joined the study: the time-stepped solvers
@@ -161,8 +164,8 @@ const PINNED_ROUGH: [(&str, &str, u64); 9] = [
     ("rough_gas", "substeps=4", 7367),
     ("rough_gas", "substeps=8", 7480),
     ("rough_gas", "substeps=16", 7495),
-    ("rough_gas", "soft", 7373),
-    ("rough_gas", "soft=8", 7286),
+    ("rough_gas", "soft", 7327),
+    ("rough_gas", "soft=8", 7267),
     ("rough_gas", "swept", 6385),
     ("rough_gas", "exact", 6385),
 ];

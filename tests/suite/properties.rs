@@ -35,13 +35,27 @@ proptest! {
         let t = pair_time_of_impact(dp, dv, sigma);
         // Swapping the pair flips both differences and must give the same answer.
         prop_assert_eq!(t, pair_time_of_impact(-dp, -dv, sigma));
-        if let Some(t) = t {
-            prop_assert!(t.is_finite() && t >= 0.0);
-            if t > 0.0 {
-                let gap = (dp + dv * t).length();
-                // Relative to the scale of the inputs, the contact distance is σ up to rounding.
-                let scale = dp.length() + sigma;
-                prop_assert!((gap - sigma).abs() <= 1e-6 * scale, "gap {} vs sigma {}", gap, sigma);
+        // Positions are known to the rounding of the larger of the offset and the contact
+        // distance: the contact's resolution, 1e-12 of it (the bound was 1e-6, which let a
+        // contact be 10⁴ σ off; at 1e-12 it found the discriminant taken as a difference of
+        // two nearly equal squares, which lost 15 of 16 digits for a pair far apart).
+        let scale = dp.length() + sigma;
+        match t {
+            Some(t) => {
+                prop_assert!(t.is_finite() && t >= 0.0);
+                if t > 0.0 {
+                    let gap = (dp + dv * t).length();
+                    prop_assert!((gap - sigma).abs() <= 1e-12 * scale, "gap {} vs sigma {}, dp {}, dv {}, t {}", gap, sigma, dp, dv, t);
+                }
+            }
+            // A miss: apart and never closer than σ while approaching (the closest approach),
+            // or already parting.
+            None => {
+                let closing = dp.dot(dv);
+                if closing < 0.0 && dv != DVec2::ZERO {
+                    let nearest = (dp - dv * (closing / dv.length_squared())).length();
+                    prop_assert!(nearest >= sigma - 1e-12 * scale, "missed: passes {} apart, sigma {}", nearest, sigma);
+                }
             }
         }
     }

@@ -181,7 +181,12 @@ fn times(me: &Motion, frame: Frame, batch: &mut Batch, len: usize) {
         let b = dot(dpx, dpy, dvx, dvy);
         let a = dot(dvx, dvy, dvx, dvy);
         let c = _mm256_sub_pd(dot(dpx, dpy, dpx, dpy), _mm256_mul_pd(sum, sum));
-        let disc = _mm256_sub_pd(_mm256_mul_pd(b, b), _mm256_mul_pd(a, c));
+        // `a·σ² - (dp × dv)²`, as `pair_time_of_impact` takes it.
+        let cross = _mm256_sub_pd(_mm256_mul_pd(dpx, dvy), _mm256_mul_pd(dpy, dvx));
+        let disc = _mm256_sub_pd(
+            _mm256_mul_pd(a, _mm256_mul_pd(sum, sum)),
+            _mm256_mul_pd(cross, cross),
+        );
         let root = _mm256_add_pd(_mm256_xor_pd(b, sign), _mm256_sqrt_pd(disc));
         let t = _mm256_div_pd(c, root);
         // `pair_time_of_impact`'s branches: none if `b >= 0`; else 0 if `c <= 0`; else none if
