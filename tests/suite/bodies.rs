@@ -13,8 +13,6 @@ use moving_circles::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const SOLVERS: [&str; 5] = ["discrete", "substeps=3", "soft", "swept", "exact"];
-
 fn empty_scene(solver: &str, arena: &str, effects: &str) -> App {
     scene_app(&format!(
         "(solver: \"{solver}\", arena: {arena}, effects: ({effects}), spawn: (count: 0))"
@@ -34,6 +32,7 @@ fn movable_energy_momentum(app: &mut App) -> (f64, DVec2) {
 #[test]
 fn a_static_peg_deflects_circles_and_never_moves() {
     for solver in SOLVERS {
+        let solver = &*solver.to_string();
         let mut app = empty_scene(
             solver,
             "(size: (12.0, 12.0), boundary: walls)",
@@ -86,6 +85,7 @@ fn steer(paddle: Res<Paddle>, totals: Res<StepTotals>, mut velocities: Query<&mu
 #[test]
 fn a_kinematic_paddle_pushes_circles_and_its_work_is_counted() {
     for solver in SOLVERS {
+        let solver = &*solver.to_string();
         let mut app = empty_scene(solver, "(size: (40.0, 20.0), boundary: periodic)", "");
         let paddle = spawn_circle(&mut app, DVec2::new(-15.0, 0.0), DVec2::ZERO, 1.0, 1.0);
         app.world_mut().entity_mut(paddle).insert(Mass::IMMOVABLE);
@@ -158,6 +158,7 @@ fn free_spot(app: &mut App, rng: &mut ChaCha8Rng, r: f64, margin: f64) -> DVec2 
 #[test]
 fn circles_come_and_go_between_steps_under_every_solver() {
     for solver in SOLVERS {
+        let solver = &*solver.to_string();
         let mut app = empty_scene(
             solver,
             "(size: (6.0, 4.0), boundary: walls)",
@@ -233,11 +234,7 @@ fn circles_come_and_go_between_steps_under_every_solver() {
         }
         // The continuous solvers never let circles overlap; the discrete ones resolve what
         // they find within the step.
-        let bound = if solver == "swept" || solver == "exact" {
-            1e-9
-        } else {
-            0.2
-        };
+        let bound = if is_continuous(solver) { 1e-9 } else { 0.2 };
         assert!(
             deepest <= bound,
             "{solver}: deepest overlap {deepest} radii"
@@ -253,6 +250,7 @@ fn circles_come_and_go_between_steps_under_every_solver() {
 #[test]
 fn a_scene_declares_static_pegs_and_refuses_moving_or_weighed_ones() {
     for solver in SOLVERS {
+        let solver = &*solver.to_string();
         let mut app = scene_app(&format!(
             "(solver: \"{solver}\", arena: (size: (6.0, 6.0), boundary: walls),
               effects: (gravity: (0.0, -4.0), restitution: 0.7),

@@ -163,7 +163,7 @@ proptest! {
     /// (so no pair that meets was dropped), while pairs that do not meet overlap freely.
     #[test]
     fn no_solver_pairs_circles_that_do_not_meet(seed in any::<u64>()) {
-        for solver in EVERY_SOLVER {
+        for solver in SOLVERS {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let mut a = grid_bodies(&mut rng, 40, DVec2::ZERO, |_, rng| random_kind(rng));
             // A second set over the first: pairs that do not meet start overlapping.
@@ -232,7 +232,7 @@ fn head_on_course(
 fn layers_set_removed_or_a_sensor_added_by_game_code_take_effect_at_the_next_step() {
     let ghost = CollisionLayers::new(0b10, 0b10);
     let nothing = |_: &mut World, _: Entity, _: Entity| {};
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         // Passing through (the kept engine predicted no hit), then made to meet before they
         // touch: they bounce.
         let (app, a) = head_on_course(

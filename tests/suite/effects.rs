@@ -56,6 +56,9 @@ fn forces_act_under_every_solver_from_the_first_step() {
     for (solver, substeps) in [
         ("discrete", 1.0),
         ("substeps=4", 4.0),
+        ("soft=1", 1.0),
+        ("soft", 4.0),
+        ("soft=8", 8.0),
         ("swept", 1.0),
         ("exact", 1.0),
     ] {

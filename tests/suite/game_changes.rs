@@ -58,7 +58,7 @@ fn scheduled(app: &App, effect: Effect) -> bool {
 
 #[test]
 fn gravity_switched_on_and_off_by_a_system_pulls_and_stops_pulling() {
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         let mut app = app(solver, (DVec2::ZERO, DVec2::ZERO), 3, |world| {
             world.resource_mut::<Effects>().gravity = Some(DVec2::new(0.0, -9.81));
         });
@@ -81,7 +81,7 @@ fn gravity_switched_on_and_off_by_a_system_pulls_and_stops_pulling() {
 
 #[test]
 fn an_arena_made_periodic_by_a_system_lets_a_circle_out_the_other_side() {
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         let circle = (DVec2::new(7.0, 0.0), DVec2::new(3.0, 0.0));
         let mut app = app(solver, circle, 2, |world| {
             world.resource_mut::<Arena>().boundary = Boundary::Periodic;
@@ -98,7 +98,7 @@ fn an_arena_made_periodic_by_a_system_lets_a_circle_out_the_other_side() {
 
 #[test]
 fn a_segment_wall_put_up_by_a_system_stops_a_circle() {
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         let circle = (DVec2::new(-3.0, 0.0), DVec2::new(3.0, 0.0));
         let mut app = app(solver, circle, 2, |world| {
             let wall = Segment::new(DVec2::new(0.0, -2.0), DVec2::new(0.0, 2.0));
@@ -118,7 +118,7 @@ fn a_segment_wall_put_up_by_a_system_stops_a_circle() {
 fn a_solver_switched_by_a_system_steps_from_then_on() {
     // Two small circles closing at 0.16 a step: a discrete step never sees them touch.
     let fast = |app: &mut App| spawn_head_on(app, 1.0, 4.8, 0.01);
-    for from in EVERY_SOLVER {
+    for from in SOLVERS {
         for to in [Solver::Exact, Solver::Discrete] {
             let mut app = create_app(CirclesConfig {
                 solver: from,
@@ -165,7 +165,7 @@ fn a_checkpoint_taken_right_after_a_games_changes_resumes_as_the_run_goes_on() {
             world.resource_mut::<Effects>().gravity = Some(DVec2::new(0.0, -9.81));
         }),
     ];
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         for (what, apply) in changes {
             let mut app = create_app(CirclesConfig {
                 solver,

@@ -8,8 +8,12 @@
 //! | overlap after any step | ≤ 1e-9 r (rounding) | ≤ 1e-9 r | bounded, ≤ 1.5 r | bounded, ≤ 1.5 r |
 //! | an overlap beyond rounding lasts at most | 0 steps | 0 steps | 60 steps | 60 steps |
 //! | energy drift (e = 1) | ≤ 1e-9 | ≤ 1e-6 | ≤ 1e-6 | ≤ 1e-6 |
-//! | momentum, where no wall acted | ≤ 1e-9 | ≤ 1e-9 | ≤ 1e-9 | ≤ 1e-9 |
+//! | momentum over each step in which no wall or immovable circle acted | ≤ 1e-9 | ≤ 1e-9 | ≤ 1e-9 | ≤ 1e-9 |
 //! | case-specific promise | ✓ | ✓ | where promised | where promised |
+//!
+//! `soft` (at 4 and 8 substeps) has the bounds of `substeps=4` on overlap only where its contacts do not
+//! press (0.08 r), and its energy bound is per case ([`soft_energy_bound`]): where many contacts
+//! meet in one step it loses energy, measured and stated case by case.
 //!
 //! Run `cargo test --test suite hard_cases:: -- --nocapture` to see the measured values.
 
@@ -27,14 +31,6 @@ use moving_circles::scene::particles;
 
 /// Overlap (in smaller radii) that is rounding, not penetration.
 const ROUNDING: f64 = 1e-9;
-
-const SOLVERS: [Solver; 5] = [
-    Solver::Exact,
-    Solver::Swept,
-    Solver::Substeps(4),
-    Solver::Discrete,
-    Solver::Soft(4),
-];
 
 fn load(name: &str) -> CirclesConfig {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -58,6 +54,8 @@ struct Outcome {
     energy_drift: f64,
     /// The same, signed: positive is energy gained.
     energy_change: f64,
+    /// The largest change of momentum over one step in which no wall or immovable circle
+    /// acted, relative to `Σ m |v|` at the start (`None` if every step had one).
     momentum_drift: Option<f64>,
     pair_collisions: u64,
     wall_collisions: u64,
@@ -78,8 +76,27 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
     let mut longest_overlap_steps = 0;
     let mut overlapped_for: HashMap<(usize, usize), u32> = HashMap::new();
     let mut end = Vec::new();
+    let scale: f64 = start.iter().map(|c| c.mass * c.velocity.length()).sum();
+    // Momentum changes only where a wall or an immovable circle pushes: over every step in
+    // which neither did, it is kept.
+    let outside = |world: &World| {
+        let pairs = world.resource::<PairCollisions>();
+        (
+            world.resource::<WallCollisions>().count,
+            pairs.immovable_impulse,
+        )
+    };
+    let mut last = (outside(app.world()), momentum_of(&start));
+    let mut momentum_drift: Option<f64> = None;
     let report = run_steps(&mut app, name, steps, 1, |mut sample| {
+        let pushed = outside(sample.world);
         let now = &sample.circles();
+        let momentum = momentum_of(now);
+        if pushed == last.0 && scale > 0.0 {
+            let drift = (momentum - last.1).length() / scale;
+            momentum_drift = Some(momentum_drift.unwrap_or(0.0).max(drift));
+        }
+        last = (pushed, momentum);
         let mut still = HashMap::new();
         for (i, j, depth) in overlapping_circles(&discs(now), &arena, &[]) {
             // Touching to rounding (exactly touching circles) is contact, not an overlap to fix.
@@ -97,8 +114,6 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
         report.steps, steps,
         "{name} under {solver}: fixed steps run"
     );
-    let scale: f64 = start.iter().map(|c| c.mass * c.velocity.length()).sum();
-    let momentum = |p: [f64; 2]| DVec2::from_array(p);
     Outcome {
         non_finite: report.non_finite,
         escaped: report.escaped,
@@ -106,9 +121,7 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
         longest_overlap_steps,
         energy_drift: report.energy_drift.abs(),
         energy_change: report.energy_drift,
-        momentum_drift: (report.wall_collisions == 0 && scale > 0.0).then(|| {
-            (momentum(report.momentum_final) - momentum(report.momentum_initial)).length() / scale
-        }),
+        momentum_drift,
         pair_collisions: report.pair_collisions,
         wall_collisions: report.wall_collisions,
         start,
@@ -120,8 +133,8 @@ fn run(name: &str, solver: Solver, steps: u64) -> Outcome {
 /// case-specific checks.
 fn suite(name: &str, steps: u64) -> Vec<(Solver, Outcome)> {
     SOLVERS
-        .iter()
-        .map(|&solver| {
+        .into_iter()
+        .map(|solver| {
             let o = run(name, solver, steps);
             println!(
                 "{name:<20} {solver:<12} overlap {:>9.2e} ({:>3} steps)  energy {:>9.2e}  momentum {:>9}  collisions {:>6} pair {:>6} wall",
@@ -139,9 +152,10 @@ fn suite(name: &str, steps: u64) -> Vec<(Solver, Outcome)> {
                 Solver::Exact => (ROUNDING, 0, 1e-9),
                 Solver::Swept => (ROUNDING, 0, 1e-6),
                 // A circle deflected within a step can press into one whose contact was only
-                // foreseen as a pass-by, which the next step pushes out softly (measured: 0.034
-                // in the jammed packing); resting contacts press for good.
-                Solver::Soft(_) => (0.05, u32::MAX, f64::INFINITY),
+                // foreseen as a pass-by, which the next step pushes out softly (measured in the
+                // jammed packing: 0.027 to 0.056 as the time of impact's rounding changed, a
+                // chaotic packing); resting contacts press for good.
+                Solver::Soft(_) => (0.08, u32::MAX, soft_energy_bound(name)),
                 // Overlaps in a chain of touching circles relax by diffusion under the one-pass
                 // separation (measured: up to 32 steps in a row of 10).
                 _ => (1.5, 60, 1e-6),
@@ -157,11 +171,48 @@ fn suite(name: &str, steps: u64) -> Vec<(Solver, Outcome)> {
             // contacts rest or hit below the restitution threshold, and bounds nothing else.
             assert!(o.energy_change <= 1e-9, "{what}: energy gained {:e}", o.energy_change);
             if let Some(m) = o.momentum_drift {
-                assert!(m <= 1e-9, "{what}: momentum drift {m:e} with no wall hit");
+                assert!(m <= 1e-9, "{what}: momentum drift {m:e} in a step with no wall hit");
             }
             (solver, o)
         })
         .collect()
+}
+
+/// `Σ m v` of circles that move.
+fn momentum_of(circles: &[CircleState]) -> DVec2 {
+    circles
+        .iter()
+        .filter(|c| c.mass.is_finite())
+        .map(|c| c.mass * c.velocity)
+        .sum()
+}
+
+/// The energy `soft` may lose on case `name` at restitution 1, at 4 or 8 substeps (measured with `cargo test --test
+/// suite hard_cases:: -- --nocapture`, 2026-12-06, and a margin): it solves a step's contacts
+/// together, so where several meet in one step (a chain, a dense packing, many hits per circle
+/// a step) the bounces share out less than the elastic hits would give; elsewhere it keeps the
+/// energy to rounding.
+fn soft_energy_bound(name: &str) -> f64 {
+    match name {
+        // 1755 circles at area fraction 0.86: every circle touches several (measured 0.67).
+        "jammed.txt" => 0.75,
+        // Five and ten circles touching in a row: the cradle's chain and the striker's row
+        // (measured 0.31 and 0.36: a simultaneous solver shares the hit along the chain).
+        "cradle.ron" => 0.35,
+        "rounding_touch.ron" => 0.4,
+        // Three arena widths a step: more hits a step than its 64 parts resolve (0.50 at 4
+        // substeps, 0.62 at 8).
+        "warp_speed.ron" => 0.7,
+        // A one-second step, many hits in each part (0.063).
+        "frame_spike.ron" => 0.08,
+        // Crowded around a circle nearly the arena's size, or at a million units, where a
+        // position's rounding is 1e-10 of a radius (0.027 and 0.015; 0.047 at 8 substeps).
+        "huge_circle.ron" => 0.06,
+        "far_offset.ron" => 0.02,
+        // A ring that meets itself: three-body contacts (4.3e-5).
+        "ring_self.ron" => 1e-4,
+        _ => 1e-9,
+    }
 }
 
 fn continuous(outcomes: &[(Solver, Outcome)]) -> impl Iterator<Item = &(Solver, Outcome)> {
@@ -170,11 +221,16 @@ fn continuous(outcomes: &[(Solver, Outcome)]) -> impl Iterator<Item = &(Solver, 
 
 #[test]
 fn coincident_and_exactly_touching_centres() {
-    let outcomes = suite("coincident.ron", 240);
-    for (solver, o) in &outcomes {
+    suite("coincident.ron", 240);
+    // The exactly touching pair (circles 4 and 5, closing at 2) trades velocities in the first
+    // step under every solver (equal masses, e = 1); the other circles are far from them.
+    for solver in SOLVERS {
+        let o = run("coincident.ron", solver, 1);
+        let (a, b) = (o.end[4].velocity, o.end[5].velocity);
         assert!(
-            o.pair_collisions > 0,
-            "{solver}: the touching pair collides"
+            (a - DVec2::new(-1.0, 0.0)).length() < 1e-9
+                && (b - DVec2::new(1.0, 0.0)).length() < 1e-9,
+            "{solver}: the touching pair moves at {a} and {b}"
         );
     }
 }
@@ -183,14 +239,16 @@ fn coincident_and_exactly_touching_centres() {
 fn touching_within_rounding_at_spawn() {
     // One second: the striker arrives at 0.4 s; the last circle reaches the wall at 1.4 s.
     let outcomes = suite("rounding_touch.ron", 60);
-    // Under exact, the row passes the striker's momentum down to the last circle.
-    let (_, exact) = &outcomes[0];
-    let last = exact.end[9];
-    assert!(
-        (last.velocity - DVec2::new(1.0, 0.0)).length() < 1e-9,
-        "last circle: {}",
-        last.velocity
-    );
+    // Under the event-driven solvers the row passes the striker's momentum down to the last
+    // circle (the time-stepped ones share it along the row: not promised).
+    for (solver, o) in continuous(&outcomes) {
+        let last = o.end[9];
+        assert!(
+            (last.velocity - DVec2::new(1.0, 0.0)).length() < 1e-9,
+            "{solver}: last circle: {}",
+            last.velocity
+        );
+    }
 }
 
 #[test]
@@ -212,16 +270,20 @@ fn grazing_tangent_paths() {
 #[test]
 fn head_on_at_eight_diameters_per_step() {
     let outcomes = suite("tunnelling.ron", 60);
-    for (solver, o) in continuous(&outcomes) {
-        assert_eq!(o.pair_collisions, 2, "{solver}: both pairs collide");
-        assert!(
+    for (solver, o) in &outcomes {
+        // `soft` splits a step into parts in which no circle moves more than a fraction of its
+        // radius, so it catches what the event solvers catch; the course's method at 4
+        // substeps still moves 2 diameters a substep and, as `discrete`, lets both pairs pass
+        // through each other (not promised: docs/solvers.md).
+        let caught = solver.is_continuous() || matches!(solver, Solver::Soft(_));
+        let expected = if caught { 2 } else { 0 };
+        assert_eq!(o.pair_collisions, expected, "{solver}: pairs that collide");
+        assert_eq!(
             o.end[0].position.x < o.end[1].position.x,
-            "{solver}: the head-on pair did not pass through"
+            caught,
+            "{solver}: the head-on pair passed through or not"
         );
     }
-    // What discrete does not promise: at this speed the pairs pass through each other.
-    let (_, discrete) = &outcomes[3];
-    assert_eq!(discrete.pair_collisions, 0);
 }
 
 #[test]
@@ -354,10 +416,17 @@ fn a_ring_meeting_itself_conserves_what_it_must() {
 #[test]
 fn speeds_that_cross_the_arena_many_times_per_step() {
     for (solver, o) in suite("warp_speed.ron", 60) {
-        for c in &o.end {
+        // Equal circles all at 200: hits trade speeds, and the root mean square speed is the
+        // energy's (kept by the solvers that promise it, lost in part by `soft`, above).
+        let rms = |c: &[CircleState]| {
+            (c.iter().map(|c| c.velocity.length_squared()).sum::<f64>() / c.len() as f64).sqrt()
+        };
+        assert!((rms(&o.start) - 200.0).abs() < 1e-9, "{solver}");
+        if !matches!(solver, Solver::Soft(_)) {
             assert!(
-                (c.velocity.length() - 200.0).abs() < 1e-6 || o.pair_collisions > 0,
-                "{solver}"
+                (rms(&o.end) - 200.0).abs() < 2e-4,
+                "{solver}: {}",
+                rms(&o.end)
             );
         }
         assert!(

@@ -25,7 +25,7 @@ fn open(solver: Solver, gravity: Option<DVec2>, segments: Vec<Segment>) -> Circl
 
 #[test]
 fn circles_leave_an_open_arena_and_meet_outside_it() {
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         let mut app = create_app(open(solver, None, Vec::new()));
         let registry = app.world().resource::<EffectRegistry>();
         assert!(!registry.is_scheduled(Effect::Walls) && !registry.is_scheduled(Effect::Periodic));
@@ -95,7 +95,7 @@ fn in_an_open_arena_segment_walls_hold_what_lands_on_them_and_the_rest_falls_awa
         Segment::new(DVec2::new(-3.0, 0.0), DVec2::new(0.0, -2.0)),
         Segment::new(DVec2::new(0.0, -2.0), DVec2::new(3.0, 0.0)),
     ];
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         let mut config = open(solver, g, cup.clone());
         config.effects.wall_restitution = 0.2;
         let mut app = create_app(config);
@@ -120,7 +120,7 @@ fn in_an_open_arena_segment_walls_hold_what_lands_on_them_and_the_rest_falls_awa
 
 #[test]
 fn a_checkpoint_with_circles_far_outside_an_open_arena_resumes_the_same() {
-    for solver in EVERY_SOLVER {
+    for solver in SOLVERS {
         let config = open(solver, Some(DVec2::new(0.0, -9.81)), Vec::new());
         let mut app = create_app(config);
         for k in 0..6 {

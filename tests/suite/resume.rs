@@ -315,7 +315,7 @@ fn resumes_bit_for_bit(scene: &str, made: impl Fn(usize, &mut bevy::ecs::world::
         app.init_resource::<Heard>().add_systems(Update, listen);
         app
     };
-    for solver in crate::common::EVERY_SOLVER {
+    for solver in crate::common::SOLVERS {
         let mut whole = listening(made_app(&config, solver, &made));
         for _ in 0..25 {
             whole.update();
@@ -407,7 +407,7 @@ fn what_code_gave_circles_of_their_own_is_kept_by_a_checkpoint_under_every_solve
             _ => circle,
         };
     };
-    for solver in crate::common::EVERY_SOLVER {
+    for solver in crate::common::SOLVERS {
         let mut app = made_app(&config, solver, &made);
         for _ in 0..25 {
             app.update();

@@ -10,20 +10,35 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::prelude::*;
 
+/// Every solver, as the tests that promise something under every solver run them: the course's
+/// method alone and at 4 substeps, the contact solver at 4 (`soft`) and 8 substeps, and the two
+/// event-driven solvers. `soft=1` is not among them yet: it breaks the hard cases' contact
+/// bounds (a tangent path deflected by 0.067, the jammed packing overlapping by 0.46 radii,
+/// measured 2026-12-06), which the contact solver's issue carries.
+pub const SOLVERS: [Solver; 6] = [
+    Solver::Discrete,
+    Solver::Substeps(4),
+    Solver::Soft(4),
+    Solver::Soft(8),
+    Solver::Swept,
+    Solver::Exact,
+];
+
+/// Whether `solver` (a solver's name) is the contact solver, at any substeps.
+pub fn is_soft(solver: &str) -> bool {
+    solver == "soft" || solver.starts_with("soft=")
+}
+
+/// Whether `solver` (a solver's name) is event-driven.
+pub fn is_continuous(solver: &str) -> bool {
+    solver == "swept" || solver == "exact"
+}
+
 /// A headless app running `config`, already past `Startup` (circles spawned), in which every
 /// `update()` advances exactly one fixed step: the same app `moving_circles run` steps.
 pub fn create_app(config: CirclesConfig) -> App {
     moving_circles::run::headless_app(config)
 }
-
-/// Every solver, once each: the time-stepped ones, then the continuous ones.
-pub const EVERY_SOLVER: [Solver; 5] = [
-    Solver::Discrete,
-    Solver::Substeps(4),
-    Solver::Soft(4),
-    Solver::Swept,
-    Solver::Exact,
-];
 
 /// A unit box asked for `fraction` of circles of radii `radius` at speed 1, placed by
 /// `placement`, run by `exact` at dt 0.01.
