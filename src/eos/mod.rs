@@ -80,26 +80,26 @@ impl EosOptions {
     pub fn check(&self) -> Result<(), FieldError> {
         if !(2..=MAX_CIRCLES).contains(&self.n) {
             return Err(FieldError::new(
-                "n",
+                "--n",
                 format!("needs 2 to {MAX_CIRCLES} disks, got {}", self.n),
             ));
         }
         if self.area_fractions.is_empty() {
-            return Err(FieldError::new("area-fractions", "none given"));
+            return Err(FieldError::new("--area-fractions", "none given"));
         }
         for &phi in &self.area_fractions {
             if !(phi > 0.0 && phi <= MAX_AREA_FRACTION) {
                 return Err(FieldError::new(
-                    "area-fractions",
+                    "--area-fractions",
                     format!("each must be in (0, {MAX_AREA_FRACTION}], got {phi}"),
                 ));
             }
             // The box and lattice are checked as a scene's are.
             config(self.n, phi, self.seed)
                 .check()
-                .map_err(|e| FieldError::new("area-fractions", format!("at {phi}: {e}")))?;
+                .map_err(|e| FieldError::new("--area-fractions", format!("at {phi}: {e}")))?;
         }
-        for (field, value) in [("equilibrate", self.equilibrate), ("block", self.block)] {
+        for (field, value) in [("--equilibrate", self.equilibrate), ("--block", self.block)] {
             if !(value > 0.0 && value <= MAX_COLLISIONS_PER_DISK) {
                 return Err(FieldError::new(
                     field,
@@ -111,7 +111,7 @@ impl EosOptions {
         }
         if !(2..=MAX_BLOCKS).contains(&self.blocks) {
             return Err(FieldError::new(
-                "blocks",
+                "--blocks",
                 format!("must be 2 to {MAX_BLOCKS}, got {}", self.blocks),
             ));
         }

@@ -121,13 +121,36 @@ impl Scene {
         }
         let options = ron::Options::default()
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-        options.from_str::<Scene>(text).map_err(|e| InputError {
-            origin: origin.to_owned(),
-            location: Some(format!(
-                "line {}, column {}",
-                e.span.start.line, e.span.start.col
-            )),
-            message: e.code.to_string(),
+        options.from_str::<Scene>(text).map_err(|e| {
+            let mut message = e.code.to_string();
+            if let ron::error::Error::NoSuchStructField { found, outer, .. } = &e.code
+                && let Some(home) = home_of(found, outer.as_deref())
+            {
+                message.push_str(&format!("; `{found}` belongs to {home}"));
+            }
+            InputError {
+                origin: origin.to_owned(),
+                location: Some(format!(
+                    "line {}, column {}",
+                    e.span.start.line, e.span.start.col
+                )),
+                message,
+            }
         })
     }
+}
+
+/// Where a field given in the wrong place of a scene belongs, for the fields that are easy to
+/// put in the wrong place: what the error adds to RON's list of the fields that fit there.
+fn home_of(field: &str, outer: Option<&str>) -> Option<&'static str> {
+    Some(match (field, outer) {
+        ("boundary", Some(outer)) if outer != "Arena" => "the arena: `arena: (boundary: periodic)`",
+        ("gravity" | "restitution" | "drag" | "friction", Some(outer)) if outer != "Effects" => {
+            "the effects: `effects: (gravity: (0.0, -9.81))`"
+        }
+        ("solver" | "dt" | "mass", Some(outer)) if outer != "Scene" => {
+            "the scene's top level: `(solver: \"exact\", dt: 0.01, ...)`"
+        }
+        _ => return None,
+    })
 }

@@ -45,8 +45,11 @@ fn an_unknown_field_is_named() {
 
 #[test]
 fn the_boundary_belongs_to_the_arena_not_the_effects() {
+    // The input names `boundary`: what the test asserts is the error's pointer to its home.
     let e = scene_error("(effects: (boundary: periodic))");
-    assert!(e.contains("boundary"), "{e}");
+    assert!(e.contains("`boundary` belongs to the arena"), "{e}");
+    let e = scene_error("(arena: (size: (4.0, 4.0), gravity: (0.0, -9.81)))");
+    assert!(e.contains("`gravity` belongs to the effects"), "{e}");
 }
 
 #[test]

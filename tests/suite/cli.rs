@@ -87,7 +87,11 @@ fn run_writes_every_report_field_and_dumps_the_final_state() {
         json["pair_collisions"].as_u64().unwrap() > 0,
         "the cue ball hits the rack"
     );
-    assert!(json["energy_drift"].as_f64().unwrap().abs() < 0.1, "{json}");
+    // Elastic hits and walls: the energy to rounding (measured: 3.5e-16).
+    assert!(
+        json["energy_drift"].as_f64().unwrap().abs() < 1e-12,
+        "{json}"
+    );
 
     let final_state =
         moving_circles::scene::particles::read(&dump, moving_circles::prelude::Boundary::Walls)
@@ -211,6 +215,13 @@ fn a_closed_stdout_is_not_a_crash() {
 /// threads, and not allowed on one and on two, are the same bytes, `lines` lines (dumped in a
 /// scratch folder named `name`).
 fn assert_same_state_with_and_without_vector_instructions(name: &str, args: &[&str], lines: usize) {
+    // Without AVX2 both runs take the same scalar path and the comparison says nothing: on
+    // x86-64 (every machine this suite runs on) the processor must have it.
+    #[cfg(target_arch = "x86_64")]
+    assert!(
+        std::arch::is_x86_feature_detected!("avx2"),
+        "this processor has no AVX2: the vector path cannot be compared with the scalar one here"
+    );
     let dir = temp_dir(name);
     let mut dumps = Vec::new();
     for (vector, threads) in [("on", "2"), ("off", "1"), ("off", "2")] {
@@ -265,28 +276,33 @@ fn the_event_engine_gives_the_same_state_with_and_without_vector_instructions() 
 
 #[test]
 fn the_final_state_does_not_depend_on_the_number_of_threads() {
-    // 10k circles: above the size from which the broad phase and the contact pass go parallel.
+    // 10k circles: above the size from which the broad phase and the contact pass go parallel
+    // (`PARALLEL_FROM`, 4 000), under the course's method and the contact solver.
     let dir = temp_dir("threads");
-    let mut dumps = Vec::new();
-    for threads in ["1", "2", "5"] {
-        let dump = dir.join(format!("threads-{threads}.txt"));
-        moving_circles(&[
-            "run",
-            "--scene",
-            "assets/scenes/gas.ron",
-            "--steps",
-            "30",
-            "--threads",
-            threads,
-            "--dump",
-            dump.to_str().unwrap(),
-        ]);
-        dumps.push(std::fs::read_to_string(&dump).unwrap());
+    for solver in ["discrete", "soft"] {
+        let mut dumps = Vec::new();
+        for threads in ["1", "2", "5"] {
+            let dump = dir.join(format!("threads-{solver}-{threads}.txt"));
+            moving_circles(&[
+                "run",
+                "--scene",
+                "assets/scenes/gas.ron",
+                "--solver",
+                solver,
+                "--steps",
+                "30",
+                "--threads",
+                threads,
+                "--dump",
+                dump.to_str().unwrap(),
+            ]);
+            dumps.push(std::fs::read_to_string(&dump).unwrap());
+        }
+        assert!(dumps[0].lines().count() > 2 * 4_000);
+        assert!(
+            dumps.iter().all(|d| *d == dumps[0]),
+            "{solver}: states differ by thread count"
+        );
     }
-    assert!(dumps[0].lines().count() > 10_000);
-    assert!(
-        dumps.iter().all(|d| *d == dumps[0]),
-        "states differ by thread count"
-    );
     std::fs::remove_dir_all(dir).ok();
 }

@@ -41,6 +41,14 @@ fn a_lattice_fills_area_fraction_0_85_with_no_overlap() {
         // Seeded: the same rules give the same circles, another seed other sites.
         let again = place_circles(&config.arena, &config.spawn, &[], &[]).unwrap();
         assert_eq!(circles, again);
+        let mut other = config.spawn.clone();
+        other.seed += 1;
+        let elsewhere = place_circles(&config.arena, &other, &[], &[]).unwrap();
+        assert_eq!(elsewhere.len(), circles.len());
+        assert_ne!(
+            elsewhere, circles,
+            "{boundary:?}: another seed, the same sites"
+        );
     }
 }
 

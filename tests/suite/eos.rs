@@ -102,10 +102,16 @@ fn the_command_writes_a_csv_and_the_figure_and_refuses_bad_options() {
         );
     }
     for (args, field) in [
-        (vec!["--blocks", "1"], "blocks"),
-        (vec!["--n", "1"], "n"),
-        (vec!["--block", "NaN"], "block"),
-        (vec!["--equilibrate", "1e300"], "equilibrate"),
+        (vec!["--blocks", "1"], "--blocks: must be 2 to"),
+        (vec!["--n", "1"], "--n: needs 2 to"),
+        (
+            vec!["--block", "NaN"],
+            "--block: collisions per disk must be in",
+        ),
+        (
+            vec!["--equilibrate", "1e300"],
+            "--equilibrate: collisions per disk must be in",
+        ),
     ] {
         let mut all = vec!["--out", out_arg];
         all.extend(args.iter());

@@ -100,21 +100,32 @@ fn a_perfectly_rough_elastic_gas_keeps_its_energy_and_momentum_over_a_million_co
     let mut engine = EventEngine::new(&circles, &arena, &[], 1.0, 1.0);
     rough(&mut engine, PERFECTLY_ROUGH);
     let start = totals(&engine, &circles);
-    run_for(&mut engine, 1_000_000, 0.05, |_| {});
+    // The share of the energy that turns, sampled over the second half (one snapshot of 1024
+    // disks scatters by about 0.015 around its mean: 0.3547 was seen at the end of one run).
+    let mut shares = Vec::new();
+    run_for(&mut engine, 1_000_000, 0.05, |engine| {
+        if engine.stats().pair_collisions > 500_000 {
+            let now = totals(engine, &circles);
+            shares.push(now.turning / now.energy());
+        }
+    });
     let end = totals(&engine, &circles);
     let (e0, e1) = (start.energy(), end.energy());
     let drift = (e1 - e0).abs() / e0;
     let scale: f64 = circles.iter().map(|c| c.velocity.length()).sum();
     let momentum = (end.momentum - start.momentum).length() / scale;
+    let share = shares.iter().sum::<f64>() / shares.len() as f64;
     println!(
-        "{} collisions: energy drift {drift:.1e}, momentum {momentum:.1e}, turning {:.4} of it",
+        "{} collisions: energy drift {drift:.1e}, momentum {momentum:.1e}, turning {share:.4} of it \
+         (mean of {} samples)",
         engine.stats().pair_collisions,
-        end.turning / e1
+        shares.len()
     );
     assert!(drift < 1e-11, "energy drifted by {drift:e}");
     assert!(momentum < 1e-12, "momentum changed by {momentum:e}");
     // It did trade spin: a third of the energy turns (one degree of freedom of three).
-    assert!((end.turning / e1 - 1.0 / 3.0).abs() < 0.02);
+    assert!(shares.len() >= 20, "{} samples", shares.len());
+    assert!((share - 1.0 / 3.0).abs() < 0.01, "turning share {share}");
 }
 
 #[test]
@@ -202,6 +213,9 @@ fn cooling_ratio(e: f64, beta: f64) -> f64 {
     r / 2.0
 }
 
+// This checks the test's oracle, not the engine: the formula as typed above must give the one
+// value known without it (equipartition, R = 1, for perfectly rough elastic disks), so that a
+// typo in it cannot pass the cooling test below against a wrong theory.
 #[test]
 fn the_theory_gives_equipartition_for_perfectly_rough_elastic_disks() {
     assert!((cooling_ratio(1.0, 1.0) - 0.5).abs() < 1e-15);

@@ -279,7 +279,23 @@ fn solvers_can_be_switched_mid_run() {
     }
     let (e1, _) = energy_momentum(&mut app);
     assert_eq!(app.world().resource::<CircleDiagnostics>().non_finite, 0);
-    assert_relative("energy across solver switches", e1, e0, 0.05);
+    // Elastic impulses keep the energy to rounding under each of these, and a switch changes
+    // nothing but the next step's method (measured: 7e-16).
+    assert_relative("energy across solver switches", e1, e0, 1e-12);
+    // `soft` then `soft=1` then back: the contact solver loses a little of a dense gas's energy
+    // where several contacts meet in a step (measured -0.0044 and -0.0099 after 30 steps each),
+    // and hands a state `exact` goes on from exactly.
+    for (solver, most) in [
+        (Solver::Soft(4), 0.01),
+        (Solver::Soft(1), 0.02),
+        (Solver::Exact, 0.02),
+    ] {
+        *app.world_mut().resource_mut::<Solver>() = solver;
+        step(&mut app, 30);
+        let (e, _) = energy_momentum(&mut app);
+        assert_relative(&format!("energy after switching to {solver}"), e, e0, most);
+        assert_eq!(app.world().resource::<CircleDiagnostics>().non_finite, 0);
+    }
 }
 
 #[test]
