@@ -2,35 +2,17 @@
 //! final state in the particle format, shows no progress bar when piped; `systems` lists what a
 //! scene schedules.
 
-use std::path::{Path, PathBuf};
+use crate::common::binary::{self, scratch_dir, stdout, successful};
+use std::path::Path;
 use std::process::Command;
-
-fn moving_circles(args: &[&str]) -> (String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("runs");
-    let (stdout, stderr) = (
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    );
-    assert!(out.status.success(), "{args:?} failed:\n{stderr}");
-    (stdout, stderr)
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mc-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Runs `moving_circles` with `args` and `--report DIR/r.json`; the report, stdout and stderr.
 fn run_with_report(dir: &Path, args: &[&str]) -> (serde_json::Value, String, String) {
     let report = dir.join("r.json");
     let mut args = args.to_vec();
     args.extend(["--report", report.to_str().unwrap()]);
-    let (stdout, stderr) = moving_circles(&args);
+    let out = successful(&args);
+    let (stdout, stderr) = (stdout(&out), binary::stderr(&out));
     let json = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     (json, stdout, stderr)
 }
@@ -57,7 +39,7 @@ const REPORT_FIELDS: [&str; 17] = [
 
 #[test]
 fn run_writes_every_report_field_and_dumps_the_final_state() {
-    let dir = temp_dir("run");
+    let dir = scratch_dir("cli", "run");
     let dump = dir.join("final.txt");
     let (json, stdout, stderr) = run_with_report(
         &dir,
@@ -102,7 +84,7 @@ fn run_writes_every_report_field_and_dumps_the_final_state() {
 
 #[test]
 fn energy_drift_is_finite_when_nothing_moves() {
-    let dir = temp_dir("rest");
+    let dir = scratch_dir("cli", "rest");
     let input = dir.join("rest.txt");
     std::fs::write(
         &input,
@@ -129,7 +111,7 @@ fn energy_drift_is_finite_when_nothing_moves() {
 
 #[test]
 fn periodic_particle_runs_wrap_instead_of_bouncing() {
-    let dir = temp_dir("periodic");
+    let dir = scratch_dir("cli", "periodic");
     let (json, ..) = run_with_report(
         &dir,
         &[
@@ -151,12 +133,11 @@ fn periodic_particle_runs_wrap_instead_of_bouncing() {
 #[test]
 fn systems_lists_what_each_scene_schedules() {
     let listing = |scene: &str| {
-        moving_circles(&[
+        stdout(&successful(&[
             "systems",
             "--scene",
             &Path::new("assets/scenes").join(scene).to_string_lossy(),
-        ])
-        .0
+        ]))
     };
     let drift = listing("drift.ron");
     let gas = listing("gas.ron");
@@ -183,7 +164,7 @@ fn systems_lists_what_each_scene_schedules() {
 #[test]
 fn a_closed_stdout_is_not_a_crash() {
     // `moving_circles run … | head -1`: the reader goes away before the summary is printed.
-    let dir = temp_dir("pipe");
+    let dir = scratch_dir("cli", "pipe");
     let report = dir.join("r.json");
     let mut child = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -222,13 +203,13 @@ fn assert_same_state_with_and_without_vector_instructions(name: &str, args: &[&s
         std::arch::is_x86_feature_detected!("avx2"),
         "this processor has no AVX2: the vector path cannot be compared with the scalar one here"
     );
-    let dir = temp_dir(name);
+    let dir = scratch_dir("cli", name);
     let mut dumps = Vec::new();
     for (vector, threads) in [("on", "2"), ("off", "1"), ("off", "2")] {
         let dump = dir.join(format!("vector-{vector}-{threads}.txt"));
         let dump_arg = dump.to_str().unwrap();
         let switches = ["--vector", vector, "--threads", threads, "--dump", dump_arg];
-        moving_circles(&[args, &switches[..]].concat());
+        successful(&[args, &switches[..]].concat());
         dumps.push(std::fs::read_to_string(&dump).unwrap());
     }
     std::fs::remove_dir_all(dir).ok();
@@ -278,12 +259,12 @@ fn the_event_engine_gives_the_same_state_with_and_without_vector_instructions() 
 fn the_final_state_does_not_depend_on_the_number_of_threads() {
     // 10k circles: above the size from which the broad phase and the contact pass go parallel
     // (`PARALLEL_FROM`, 4 000), under the course's method and the contact solver.
-    let dir = temp_dir("threads");
+    let dir = scratch_dir("cli", "threads");
     for solver in ["discrete", "soft"] {
         let mut dumps = Vec::new();
         for threads in ["1", "2", "5"] {
             let dump = dir.join(format!("threads-{solver}-{threads}.txt"));
-            moving_circles(&[
+            successful(&[
                 "run",
                 "--scene",
                 "assets/scenes/gas.ron",

@@ -3,17 +3,14 @@
 //! a panic or an abort, and nothing from a file may reach the terminal as a raw control byte.
 #![cfg(unix)]
 
+use crate::common::binary::scratch_dir;
 use std::os::unix::fs::FileTypeExt;
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use crate::common::binary::{assert_refused, moving_circles, under_one_gib};
 use moving_circles::config::MAX_CIRCLES;
 
 /// A scratch folder for the test `name`.
-fn temp_dir(name: &str) -> PathBuf {
-    crate::common::binary::scratch_dir("hostile", name)
-}
 
 /// `run` on two steps of the classic scene, with `extra` flags.
 fn run_classic(extra: &[&str]) -> Output {
@@ -30,7 +27,7 @@ fn run_classic(extra: &[&str]) -> Output {
 
 #[test]
 fn radii_spanning_the_whole_f64_range_are_refused_not_a_panic() {
-    let dir = temp_dir("radii");
+    let dir = scratch_dir("hostile", "radii");
     // A subnormal radius beside a normal one: the broad phase's ratio of radii overflowed.
     let file = dir.join("subnormal.txt");
     std::fs::write(
@@ -121,7 +118,7 @@ fn has_raw_control(bytes: &[u8]) -> bool {
 
 #[test]
 fn bytes_from_files_and_names_reach_the_terminal_escaped() {
-    let dir = temp_dir("escape");
+    let dir = scratch_dir("hostile", "escape");
     // An escape sequence that would retitle the terminal, in a number of a particle file.
     let file = dir.join("title.txt");
     std::fs::write(&file, "1\n0.5 \x1b]0;pwned\x07 0 0 0.1 1 9 9 9\n").unwrap();
@@ -149,7 +146,7 @@ fn bytes_from_files_and_names_reach_the_terminal_escaped() {
 
 #[test]
 fn outputs_go_to_regular_files_only_and_never_to_one_file_twice() {
-    let dir = temp_dir("outputs");
+    let dir = scratch_dir("hostile", "outputs");
     let run_to = |flag: &str, path: &std::path::Path| run_classic(&[flag, path.to_str().unwrap()]);
     // A pipe stands in for a device node: replacing it is what must not happen.
     let pipe = dir.join("pipe");
@@ -200,7 +197,7 @@ fn outputs_go_to_regular_files_only_and_never_to_one_file_twice() {
 
 #[test]
 fn inputs_that_never_end_or_pile_up_are_refused_within_bounded_memory() {
-    let dir = temp_dir("bounded");
+    let dir = scratch_dir("hostile", "bounded");
     // 20 000 circles at one point: 2·10⁸ overlapping pairs if an overlap check lists them.
     let piled = dir.join("piled.txt");
     let mut text = String::from("20000\n");
@@ -250,7 +247,7 @@ fn work_that_would_take_hours_is_refused_up_front() {
         &out,
         &["--seconds must be positive and at most 10000000000 steps"],
     );
-    let dir = temp_dir("hours");
+    let dir = scratch_dir("hostile", "hours");
     let scene = dir.join("tries.ron");
     std::fs::write(
         &scene,
@@ -267,7 +264,7 @@ fn work_that_would_take_hours_is_refused_up_front() {
 
 #[test]
 fn one_physical_range_for_every_value_of_every_input() {
-    let dir = temp_dir("range");
+    let dir = scratch_dir("hostile", "range");
     // Scenes: each value past the range names its field.
     let scenes = [
         (

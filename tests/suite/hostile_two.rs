@@ -3,18 +3,15 @@
 //! refusal names what it refuses.
 #![cfg(unix)]
 
-use std::path::PathBuf;
+use crate::common::binary::scratch_dir;
 
 use crate::common::binary::{assert_refused, stderr, under_one_gib};
 
 /// A scratch folder for the test `name`.
-fn temp_dir(name: &str) -> PathBuf {
-    crate::common::binary::scratch_dir("hostile2", name)
-}
 
 #[test]
 fn a_long_thin_arena_runs_in_bounded_memory() {
-    let dir = temp_dir("thin");
+    let dir = scratch_dir("hostile2", "thin");
     // One side 10^18, the other 9: the placement grid once asked for a row of 1.9·10^9 cells.
     // Every solver builds its own grids over the arena, and `systems` places the circles too.
     for boundary in ["walls", "periodic"] {
@@ -96,7 +93,7 @@ fn counts_of_zero_are_usage_errors() {
 
 #[test]
 fn a_refused_compression_names_its_scene() {
-    let dir = temp_dir("pack");
+    let dir = scratch_dir("hostile2", "pack");
     let scene = dir.join("pack.ron");
     std::fs::write(
         &scene,
@@ -114,7 +111,7 @@ fn a_refused_compression_names_its_scene() {
 #[test]
 fn long_placements_are_announced_as_what_they_are() {
     // A lattice of a million circles was announced as "placing 1000000 circles at random".
-    let dir = temp_dir("announce");
+    let dir = scratch_dir("hostile2", "announce");
     let cases = [
         (
             "lattice",
@@ -144,7 +141,7 @@ fn long_placements_are_announced_as_what_they_are() {
 
 #[test]
 fn an_equation_of_state_of_too_many_disks_blames_n() {
-    let dir = temp_dir("eos");
+    let dir = scratch_dir("hostile2", "eos");
     let out = under_one_gib(&[
         "eos",
         "--n",
@@ -159,7 +156,7 @@ fn an_equation_of_state_of_too_many_disks_blames_n() {
 
 #[test]
 fn a_dump_of_static_circles_reads_back_as_the_same_circles() {
-    let dir = temp_dir("static");
+    let dir = scratch_dir("hostile2", "static");
     let (first, second) = (dir.join("first.txt"), dir.join("second.txt"));
     // Pegs in the unit square (the particle format's arena): the dump writes their mass `inf`.
     let scene = dir.join("pegs.ron");
@@ -227,7 +224,7 @@ fn a_dump_of_static_circles_reads_back_as_the_same_circles() {
 
 #[test]
 fn a_drop_rule_out_of_range_is_refused_by_the_run_naming_the_file_and_field() {
-    let dir = temp_dir("drops");
+    let dir = scratch_dir("hostile2", "drops");
     // A subnormal radius, and a mass from the drops' own radius below the least mass.
     for (rule, field) in [
         (
@@ -255,7 +252,7 @@ fn a_circle_too_fast_for_the_clock_never_falls_asleep_outside_the_walls() {
     // 8.8e28 m/s. Its hits pass that speed on, and a circle crossing metres in the clock's
     // last tick fell asleep (jammed by quick hits) with its centre 0.7 m past the top wall,
     // where sleep kept it: step 2 of the resumed run ended with a circle outside.
-    let dir = temp_dir("too-fast");
+    let dir = scratch_dir("hostile2", "too-fast");
     let report = dir.join("r.json");
     let out = crate::common::binary::moving_circles(&[
         "run",
@@ -279,7 +276,7 @@ fn a_state_past_the_range_of_values_is_not_written_as_what_our_readers_refuse() 
     // range), one of them 340 times lighter than the others. Hits pass it more than 10³⁰ m/s,
     // and the checkpoint of the run's end was written and then refused by our own reader.
     // Such a state is refused as a non-finite one is: nothing written, one line saying why.
-    let dir = temp_dir("past-range");
+    let dir = scratch_dir("hostile2", "past-range");
     let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
     let (report, dump, checkpoint) = (path("r.json"), path("d.txt"), path("c"));
     let out = crate::common::binary::moving_circles(&[
@@ -336,7 +333,7 @@ fn a_run_that_leaves_the_range_of_values_stops_at_the_first_sample_past_it() {
     // run went on to its end (seconds a step at speeds past 10³⁰ under the event-driven
     // solvers) only to write nothing. Here a heavy circle at 10³⁰ m/s throws a light one past
     // it. The run stops at the sample that shows it, says which step, and writes nothing.
-    let dir = temp_dir("leaves-range");
+    let dir = scratch_dir("hostile2", "leaves-range");
     let scene = dir.join("s.ron");
     std::fs::write(
         &scene,

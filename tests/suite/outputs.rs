@@ -4,14 +4,11 @@
 //! written loses none of the other outputs.
 #![cfg(unix)]
 
-use std::path::PathBuf;
+use crate::common::binary::scratch_dir;
 
 use crate::common::binary::{assert_refused, command, stderr, under_one_gib};
 
 /// A scratch folder for the test `name`.
-fn temp_dir(name: &str) -> PathBuf {
-    crate::common::binary::scratch_dir("outputs", name)
-}
 
 /// Two steps of `scene` with `flag` (an output) naming `path`, under the memory bound.
 fn two_steps_writing(scene: &str, flag: &str, path: &str) -> std::process::Output {
@@ -20,7 +17,7 @@ fn two_steps_writing(scene: &str, flag: &str, path: &str) -> std::process::Outpu
 
 #[test]
 fn an_output_never_replaces_the_runs_own_input() {
-    let dir = temp_dir("inputs");
+    let dir = scratch_dir("outputs", "inputs");
     let scene = dir.join("scene.ron");
     let text = "(spawn: (count: 8))";
     std::fs::write(&scene, text).unwrap();
@@ -74,7 +71,7 @@ fn an_output_never_replaces_the_runs_own_input() {
 
 #[test]
 fn an_output_name_too_long_for_its_temporary_file_is_refused_before_the_run() {
-    let dir = temp_dir("names");
+    let dir = scratch_dir("outputs", "names");
     let scene = "assets/scenes/classic.ron";
     // 239 bytes is the longest name whose temporary file (16 bytes more) a file system takes.
     for (length, ok) in [(239, true), (240, false), (255, false)] {
@@ -102,7 +99,7 @@ impl Drop for Killed {
 
 #[test]
 fn a_checkpoint_that_cannot_be_written_ends_the_run_with_the_other_outputs_written() {
-    let dir = temp_dir("full");
+    let dir = scratch_dir("outputs", "full");
     let folder = dir.join("checkpoints");
     std::fs::create_dir(&folder).unwrap();
     let checkpoint = folder.join("c.ckpt");

@@ -7,27 +7,8 @@
 //! Both go through the command line (`run --dump`, `accuracy --quick`), whose outputs are a
 //! stable contract, so moving code inside the library never needs this file to change.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn moving_circles(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mc-pinned-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common::binary::{scratch_dir, successful};
+use std::path::Path;
 
 /// FNV-1a over bytes: defined here, so the pinned values cannot move with a hasher's version.
 fn fnv1a(hash: u64, bytes: &[u8]) -> u64 {
@@ -38,7 +19,7 @@ fn fnv1a(hash: u64, bytes: &[u8]) -> u64 {
 
 /// A hash of the exact bits of every circle's position and velocity in a particle-format dump,
 /// in the dump's order (which is spawn order).
-fn state_hash(dump: &Path) -> u64 {
+fn dump_hash(dump: &Path) -> u64 {
     let text = std::fs::read_to_string(dump).unwrap();
     let mut hash = 0xcbf2_9ce4_8422_2325;
     for line in text.lines().skip(1) {
@@ -80,12 +61,12 @@ const PINNED_STATES: [(&str, &str, u64); 17] = [
 
 #[test]
 fn the_final_states_of_600_steps_are_unchanged_bit_for_bit() {
-    let dir = temp_dir("states");
+    let dir = scratch_dir("pinned", "states");
     let mut differ = Vec::new();
     for (scene, solver, expected) in PINNED_STATES {
         let dump = dir.join(format!("{scene}-{solver}.txt"));
         let scene_path = format!("assets/scenes/{scene}.ron");
-        moving_circles(&[
+        successful(&[
             "run",
             "--scene",
             &scene_path,
@@ -96,7 +77,7 @@ fn the_final_states_of_600_steps_are_unchanged_bit_for_bit() {
             "--dump",
             dump.to_str().unwrap(),
         ]);
-        let hash = state_hash(&dump);
+        let hash = dump_hash(&dump);
         println!("(\"{scene}\", \"{solver}\", {hash:#018x}),");
         if hash != expected {
             differ.push(format!(
@@ -172,8 +153,8 @@ const PINNED_ROUGH: [(&str, &str, u64); 9] = [
 
 #[test]
 fn the_accuracy_studys_collision_counts_are_unchanged() {
-    let dir = temp_dir("accuracy");
-    moving_circles(&["accuracy", "--quick", "--out", dir.to_str().unwrap()]);
+    let dir = scratch_dir("pinned", "accuracy");
+    successful(&["accuracy", "--quick", "--out", dir.to_str().unwrap()]);
     let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
     std::fs::remove_dir_all(&dir).ok();
     let mut lines = csv.lines();

@@ -7,13 +7,10 @@
 //! what code gave circles of their own is kept.
 #![cfg(unix)]
 
-use std::path::{Path, PathBuf};
+use crate::common::binary::scratch_dir;
+use std::path::Path;
 
 use crate::common::binary::{successful, under_one_gib};
-
-fn temp_dir(name: &str) -> PathBuf {
-    crate::common::binary::scratch_dir("resume", name)
-}
 
 fn text(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap()
@@ -30,7 +27,7 @@ fn untimed(report: &Path) -> serde_json::Value {
 
 #[test]
 fn a_resumed_run_ends_bit_for_bit_where_the_whole_run_ends_under_every_solver() {
-    let dir = temp_dir("identical");
+    let dir = scratch_dir("resume", "identical");
     let p = |name: &str| dir.join(name).to_str().unwrap().to_owned();
     let (whole_txt, whole_json, c1) = (p("whole.txt"), p("whole.json"), p("c1"));
     // A walled rack of billiards and a periodic gas: the engine's events cross the pause; and a
@@ -98,7 +95,7 @@ fn a_resumed_run_ends_bit_for_bit_where_the_whole_run_ends_under_every_solver() 
 
 #[test]
 fn a_checkpoint_that_is_damaged_or_not_one_is_refused_by_name() {
-    let dir = temp_dir("damaged");
+    let dir = scratch_dir("resume", "damaged");
     let checkpoint = dir.join("c");
     let c = checkpoint.to_str().unwrap();
     successful(&[
@@ -396,7 +393,6 @@ fn circles_of_their_own_restitution_resume_bit_for_bit_under_every_solver() {
 
 #[test]
 fn what_code_gave_circles_of_their_own_is_kept_by_a_checkpoint_under_every_solver() {
-    use bevy::prelude::*;
     use moving_circles::checkpoint::Checkpoint;
     use moving_circles::collision_layers::Sensor;
     use moving_circles::prelude::*;

@@ -5,15 +5,12 @@
 //! without touching what was there.
 #![cfg(unix)]
 
+use crate::common::binary::scratch_dir;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::common::binary::{command, successful};
-
-fn temp_dir(name: &str) -> PathBuf {
-    crate::common::binary::scratch_dir("signals", name)
-}
 
 fn text(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap()
@@ -83,7 +80,7 @@ fn signal(child: &Child, name: &str) {
 #[test]
 fn a_signal_ends_the_run_after_a_step_with_everything_written() {
     for (name, code) in [("INT", 130), ("TERM", 143)] {
-        let dir = temp_dir(&format!("signal-{name}"));
+        let dir = scratch_dir("signals", &format!("signal-{name}"));
         let mut child = start_long_run(&dir);
         signal(&child, name);
         let status = child.wait().unwrap();
@@ -115,7 +112,7 @@ fn a_signal_ends_the_run_after_a_step_with_everything_written() {
 
 #[test]
 fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
-    let dir = temp_dir("long-step");
+    let dir = scratch_dir("signals", "long-step");
     let report = dir.join("r.json");
     // One step of 60 s of the 10 000-circle gas: seconds of events.
     let mut child = command(&[
@@ -172,7 +169,7 @@ fn a_signal_while_circles_are_placed_ends_the_run_at_once_and_writes_nothing() {
 /// Runs `scene`, signals it as soon as it says it is `placing` (its first line), and asserts
 /// it ends within a second writing nothing.
 fn signalled_while_placing(scene_text: &str, placing: &str) {
-    let dir = temp_dir("placing");
+    let dir = scratch_dir("signals", "placing");
     let (mut run, report) = run_over_old_report(&dir, scene_text, 10);
     let mut child = run
         .stdout(Stdio::piped())
@@ -209,7 +206,7 @@ fn signalled_while_placing(scene_text: &str, placing: &str) {
 
 #[test]
 fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
-    let dir = temp_dir("twice");
+    let dir = scratch_dir("signals", "twice");
     // Placing a million circles takes seconds: both signals arrive before the first step.
     let million = "(arena: (size: (1000.0, 1000.0)), spawn: (count: 1000000, radius: (0.1, 0.1)))";
     let (mut run, report) = run_over_old_report(&dir, million, 100);
@@ -239,7 +236,7 @@ fn a_signal_while_a_particle_file_is_read_ends_the_run_and_writes_nothing() {
     // A pipe of blank lines that never ends: the reader skips them one by one, within the
     // size limit for a long while. A signal ends it there (the first signal only asks, so the
     // reader must ask back).
-    let dir = temp_dir("reading");
+    let dir = scratch_dir("signals", "reading");
     let report = dir.join("r.json");
     std::fs::write(&report, "old").unwrap();
     let mut child = command(&[

@@ -71,6 +71,11 @@ pub fn read_report(path: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&text).expect("a JSON report")
 }
 
+/// What the run wrote to stdout.
+pub fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 /// What the run wrote to stderr.
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
