@@ -315,3 +315,42 @@ fn a_flag_out_of_its_range_gets_the_flags_rule_not_the_parsers() {
     let (ok, err) = cli(&["eos", "--seed", "-2", "--n", "16"]);
     assert!(!ok && err.contains("whole number from 0 to"), "{err}");
 }
+
+#[test]
+fn sleep_and_drop_rules_are_checked_field_by_field() {
+    let g = "gravity: (0.0, -9.81)";
+    for (ron, expected) in [
+        (
+            format!("(effects: ({g}, sleep: (enabled: true, speed: -1.0, time: 0.5)))"),
+            "bad.ron: field `effects.sleep.speed`: must be from 0 to 1e30, got -1",
+        ),
+        (
+            format!("(effects: ({g}, sleep: (enabled: true, speed: 0.1, time: 1e40)))"),
+            "bad.ron: field `effects.sleep.time`: must be from 0 to 1e30",
+        ),
+        (
+            "(drop: (count: 3, every: -0.1, position: (0.0, 0.0), radius: 0.1))".into(),
+            "bad.ron: field `drop.every`: must be a positive number of seconds, got -0.1",
+        ),
+        (
+            "(drop: (count: 3, every: 0.1, position: (1e9, 0.0), radius: 0.1))".into(),
+            "bad.ron: field `drop.position`: [1000000000, 0] ± 0 with radius 0.1 must lie inside",
+        ),
+        (
+            "(drop: (count: 3, every: 0.1, position: (0.0, 0.0), spread: -1.0, radius: 0.1))"
+                .into(),
+            "bad.ron: field `drop.spread`: must be a distance of 0 or more, got -1",
+        ),
+        (
+            "(drop: (count: 3, every: 0.1, position: (0.0, 0.0), radius: 0.1, velocity: (1e40, 0.0)))"
+                .into(),
+            "bad.ron: field `drop.velocity`: must be finite and at most 1e30",
+        ),
+        (
+            "(drop: (count: 99999999999, every: 0.1, position: (0.0, 0.0), radius: 0.1))".into(),
+            "bad.ron: field `drop.count`: asks for 99999999999 circles; at most 5000000",
+        ),
+    ] {
+        assert_starts(&scene_error(&ron), expected);
+    }
+}

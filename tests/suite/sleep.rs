@@ -1,6 +1,6 @@
 //! Sleeping under the time-stepped solvers: a heap at rest falls asleep and stays exactly where
 //! it is, a ball dropped onto it wakes it and it sleeps again (a fast one in the step it
-//! arrives, under every `soft=N`), your code's writes wake a
+//! arrives, under every `soft=N`, `substeps=4`, `swept` and `exact`), your code's writes wake a
 //! sleeping circle, a change of the effects wakes them all, and nothing sleeps without gravity
 //! (a circle a checkpoint marks asleep is awake under `exact` and `swept` without it).
 
@@ -131,7 +131,7 @@ fn a_ball_that_reaches_a_sleeping_heap_within_one_step_wakes_it_in_that_step() {
     // At 60 m/s the ball covers a metre a step: it starts 0.6 above the heap (far outside
     // touching) and meets it before the step ends. The heap must wake before that step, so
     // that the hit moves it, not bounce the ball off circles held as immovable.
-    for solver in ["soft", "soft=1", "soft=8", "substeps=4"] {
+    for solver in ["soft", "soft=1", "soft=8", "substeps=4", "swept", "exact"] {
         let mut app = heap(solver);
         until_asleep(&mut app, 20.0).expect("asleep");
         let top = snapshot(app.world_mut())
