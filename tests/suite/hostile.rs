@@ -10,8 +10,6 @@ use std::process::{Command, Output};
 use crate::common::binary::{assert_refused, moving_circles, under_one_gib};
 use moving_circles::config::MAX_CIRCLES;
 
-/// A scratch folder for the test `name`.
-
 /// `run` on two steps of the classic scene, with `extra` flags.
 fn run_classic(extra: &[&str]) -> Output {
     let mut args = vec![

@@ -7,8 +7,6 @@ use crate::common::binary::scratch_dir;
 
 use crate::common::binary::{assert_refused, stderr, under_one_gib};
 
-/// A scratch folder for the test `name`.
-
 #[test]
 fn a_long_thin_arena_runs_in_bounded_memory() {
     let dir = scratch_dir("hostile2", "thin");

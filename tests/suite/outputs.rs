@@ -8,8 +8,6 @@ use crate::common::binary::scratch_dir;
 
 use crate::common::binary::{assert_refused, command, stderr, under_one_gib};
 
-/// A scratch folder for the test `name`.
-
 /// Two steps of `scene` with `flag` (an output) naming `path`, under the memory bound.
 fn two_steps_writing(scene: &str, flag: &str, path: &str) -> std::process::Output {
     under_one_gib(&["run", "--scene", scene, "--steps", "2", flag, path])
