@@ -70,17 +70,7 @@ fn auto_picks_a_continuous_solver_for_a_tight_tolerance_and_a_cheap_one_for_a_lo
 
 #[test]
 fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
-    let out = std::env::temp_dir().join(format!("mc-accuracy-{}", std::process::id()));
-    let status = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["accuracy", "--quick", "--out", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        status.status.success(),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
+    let out = crate::common::binary::quick_study();
     let csv = std::fs::read_to_string(out.join("accuracy.csv")).unwrap();
     for solver in [
         "discrete",
@@ -185,7 +175,6 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
             "{solver} settled: {r:?}"
         );
     }
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]

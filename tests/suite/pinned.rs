@@ -7,7 +7,7 @@
 //! Both go through the command line (`run --dump`, `accuracy --quick`), whose outputs are a
 //! stable contract, so moving code inside the library never needs this file to change.
 
-use crate::common::binary::{scratch_dir, successful};
+use crate::common::binary::{quick_study, scratch_dir, successful};
 use std::path::Path;
 
 /// FNV-1a over bytes: defined here, so the pinned values cannot move with a hasher's version.
@@ -153,10 +153,7 @@ const PINNED_ROUGH: [(&str, &str, u64); 9] = [
 
 #[test]
 fn the_accuracy_studys_collision_counts_are_unchanged() {
-    let dir = scratch_dir("pinned", "accuracy");
-    successful(&["accuracy", "--quick", "--out", dir.to_str().unwrap()]);
-    let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
+    let csv = std::fs::read_to_string(quick_study().join("accuracy.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let column = |name: &str| header.iter().position(|&h| h == name).unwrap();

@@ -71,6 +71,18 @@ pub fn read_report(path: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&text).expect("a JSON report")
 }
 
+/// The folder of the quick accuracy study (`accuracy --quick`: accuracy.csv, .svg and .png,
+/// piles.csv), run once for the whole suite by the first test that asks (the others wait for
+/// it), and left in the system's temporary folder.
+pub fn quick_study() -> &'static std::path::Path {
+    static OUT: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    OUT.get_or_init(|| {
+        let dir = scratch_dir("study", "quick");
+        successful(&["accuracy", "--quick", "--out", dir.to_str().unwrap()]);
+        dir
+    })
+}
+
 /// What the run wrote to stdout.
 pub fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
