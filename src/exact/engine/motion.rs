@@ -17,6 +17,9 @@ impl EventEngine {
     /// `span` seconds: under strong gravity, about how often each circle bounces (0 without
     /// gravity or moving circles).
     pub fn falls_in(&self, span: f64) -> f64 {
+        if self.gravity == DVec2::ZERO {
+            return 0.0;
+        }
         let least = self
             .motion
             .iter()
@@ -24,10 +27,7 @@ impl EventEngine {
             .filter(|(_, w)| **w > 0.0)
             .map(|(m, _)| m.radius)
             .reduce(f64::min);
-        match least {
-            Some(r) if self.gravity != DVec2::ZERO => span * (self.gravity.length() / r).sqrt(),
-            _ => 0.0,
-        }
+        least.map_or(0.0, |r| span * (self.gravity.length() / r).sqrt())
     }
 
     /// Where circle `i` is at time `t` on its current course (not wrapped).
