@@ -100,8 +100,7 @@ impl EventEngine {
         let jammed = if e < 1.0 {
             self.near_anchor(i)
         } else {
-            let m = &self.motion[i];
-            m.vel.length_squared() < 2.0 * self.gravity.length() * ROUNDING_HEIGHT * m.radius
+            self.slower_than_a_fall(i, ROUNDING_HEIGHT)
         };
         if jammed {
             self.fall_asleep(i);
@@ -179,8 +178,7 @@ impl EventEngine {
         let along = v - n * v.dot(n);
         // Sleep only when held and all but still; a circle sliding fast along a floor, or held
         // by nothing, slides on.
-        let r = self.motion[i].radius;
-        let still = v.length_squared() < 2.0 * self.gravity.length() * WAKE_HEIGHT * r;
+        let still = self.slower_than_a_fall(i, WAKE_HEIGHT);
         if (still && self.held(i)) || self.stayed(i) {
             self.fall_asleep(i);
         } else if v.length() > least && along != DVec2::ZERO {
@@ -192,6 +190,12 @@ impl EventEngine {
             // with the least bounce.
             self.motion[i].vel = along - n * least;
         }
+    }
+
+    /// Whether circle `i` moves slower than a fall of `height` of its radius gives.
+    fn slower_than_a_fall(&self, i: usize, height: f64) -> bool {
+        let m = &self.motion[i];
+        m.vel.length_squared() < 2.0 * self.gravity.length() * height * m.radius
     }
 
     /// Whether circle `i`, bouncing its least bounce, has stayed within [`RESTING_DRIFT`] of its
