@@ -123,8 +123,8 @@ impl Scene {
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
         options.from_str::<Scene>(text).map_err(|e| {
             let mut message = e.code.to_string();
-            if let ron::error::Error::NoSuchStructField { found, outer, .. } = &e.code
-                && let Some(home) = home_of(found, outer.as_deref())
+            if let ron::error::Error::NoSuchStructField { found, .. } = &e.code
+                && let Some(home) = home_of(found)
             {
                 message.push_str(&format!("; `{found}` belongs to {home}"));
             }
@@ -141,16 +141,15 @@ impl Scene {
 }
 
 /// Where a field given in the wrong place of a scene belongs, for the fields that are easy to
-/// put in the wrong place: what the error adds to RON's list of the fields that fit there.
-fn home_of(field: &str, outer: Option<&str>) -> Option<&'static str> {
-    Some(match (field, outer) {
-        ("boundary", Some(outer)) if outer != "Arena" => "the arena: `arena: (boundary: periodic)`",
-        ("gravity" | "restitution" | "drag" | "friction", Some(outer)) if outer != "Effects" => {
+/// put in the wrong place: what the error adds to RON's list of the fields that fit there (the
+/// field is unknown where it stands, so that is never its home).
+fn home_of(field: &str) -> Option<&'static str> {
+    Some(match field {
+        "boundary" => "the arena: `arena: (boundary: periodic)`",
+        "gravity" | "restitution" | "drag" | "friction" => {
             "the effects: `effects: (gravity: (0.0, -9.81))`"
         }
-        ("solver" | "dt" | "mass", Some(outer)) if outer != "Scene" => {
-            "the scene's top level: `(solver: \"exact\", dt: 0.01, ...)`"
-        }
+        "solver" | "dt" | "mass" => "the scene's top level: `(solver: \"exact\", dt: 0.01, ...)`",
         _ => return None,
     })
 }
