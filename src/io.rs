@@ -117,16 +117,53 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
 /// it was.
 #[derive(Debug)]
 pub struct Staged {
-    file: tempfile::NamedTempFile,
+    /// `None` once committed.
+    file: Option<tempfile::NamedTempFile>,
     path: std::path::PathBuf,
 }
 
 impl Staged {
     /// Puts the file in place of `path` (a rename).
-    pub fn commit(self) -> io::Result<()> {
-        self.file.persist(&self.path).map_err(|e| e.error)?;
+    pub fn commit(mut self) -> io::Result<()> {
+        let mut staged = staged_files();
+        let file = self.file.take().expect("a staged file is committed once");
+        let temporary = file.path().to_owned();
+        staged.retain(|p| *p != temporary);
+        file.persist(&self.path).map_err(|e| e.error)?;
         Ok(())
     }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if let Some(file) = self.file.take() {
+            let mut staged = staged_files();
+            let temporary = file.path().to_owned();
+            staged.retain(|p| *p != temporary);
+            // Removed (by the temporary file's own drop) while the list is held.
+            drop(file);
+        }
+    }
+}
+
+/// The temporary files [`stage`] has made and not yet put in place or removed: what
+/// [`exit_removing_staged`] removes.
+static STAGED: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// [`STAGED`], held: a panic elsewhere while it was held leaves a list still worth reading.
+fn staged_files() -> std::sync::MutexGuard<'static, Vec<std::path::PathBuf>> {
+    STAGED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Ends the process with `code` at once, from any thread, first removing every temporary file
+/// of an output being written: what is in place stays as it was, and nothing half-written is
+/// left beside it. The list stays held until the end, so no output is put in place meanwhile.
+pub fn exit_removing_staged(code: i32) -> ! {
+    let staged = staged_files();
+    for temporary in staged.iter() {
+        let _ = std::fs::remove_file(temporary);
+    }
+    std::process::exit(code)
 }
 
 /// Writes `bytes` to a temporary file beside `path`, as [`write_atomically`] does, and leaves it
@@ -146,15 +183,22 @@ pub fn stage(path: &Path, bytes: &[u8]) -> io::Result<Staged> {
         // What a plain `File::create` would give: 0666 less the umask.
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut file = builder.tempfile_in(directory_of(path))?;
+    // Made and listed while the list is held: a forced exit finds every temporary file.
+    let mut staged = {
+        let mut list = staged_files();
+        let file = builder.tempfile_in(directory_of(path))?;
+        list.push(file.path().to_owned());
+        Staged {
+            file: Some(file),
+            path: path.to_owned(),
+        }
+    };
+    let file = staged.file.as_mut().expect("just made");
     file.write_all(bytes)?;
     file.as_file().sync_all()?;
     // On a failure to commit, the temporary file comes back inside the error and is removed as
     // it drops.
-    Ok(Staged {
-        file,
-        path: path.to_owned(),
-    })
+    Ok(staged)
 }
 
 /// The end of [`write_atomically`]'s temporary file's name.
@@ -299,6 +343,34 @@ pub fn say(line: impl std::fmt::Display) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_staged_file_is_listed_for_a_forced_exit_until_it_is_in_place_or_removed() {
+        let dir = std::env::temp_dir().join(format!("mc-staged-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let listed = |staged: &Staged| {
+            let temporary = staged.file.as_ref().unwrap().path().to_owned();
+            (staged_files().contains(&temporary), temporary)
+        };
+        let kept = stage(&dir.join("kept.txt"), b"kept").unwrap();
+        let (is_listed, kept_temporary) = listed(&kept);
+        assert!(is_listed);
+        kept.commit().unwrap();
+        assert!(!staged_files().contains(&kept_temporary));
+        let dropped = stage(&dir.join("dropped.txt"), b"dropped").unwrap();
+        let (is_listed, dropped_temporary) = listed(&dropped);
+        assert!(is_listed);
+        drop(dropped);
+        assert!(!staged_files().contains(&dropped_temporary));
+        assert!(!dropped_temporary.exists());
+        let mut left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["kept.txt"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn replaces_the_file_whole_and_leaves_nothing_behind() {

@@ -113,8 +113,9 @@ fn a_signal_ends_the_run_after_a_step_with_everything_written() {
 #[test]
 fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
     let dir = scratch_dir("signals", "long-step");
-    let report = dir.join("r.json");
-    // One step of 60 s of the 10 000-circle gas: seconds of events.
+    let (report, checkpoint) = (dir.join("r.json"), dir.join("c"));
+    // Steps of 60 s of the 10 000-circle gas: seconds of events each. The checkpoint after the
+    // first says the second has begun.
     let mut child = command(&[
         "run",
         "--scene",
@@ -127,12 +128,16 @@ fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
         "3",
         "--report",
         report.to_str().unwrap(),
+        "--checkpoint",
+        checkpoint.to_str().unwrap(),
+        "--every",
+        "1",
     ])
     .stdout(Stdio::null())
     .stderr(Stdio::null())
     .spawn()
     .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
+    wait_for(&checkpoint);
     signal(&child, "TERM");
     let sent = Instant::now();
     let status = child.wait().unwrap();
@@ -140,14 +145,27 @@ fn a_signal_ends_a_long_exact_step_at_once_with_everything_written() {
     assert_eq!(status.code(), Some(143));
     let report: serde_json::Value = serde_json::from_str(&text(&report)).unwrap();
     assert_eq!(report["interrupted"], true);
-    // The step was ended by drifting to its end, as when the event budget runs out.
-    assert_eq!(report["steps"].as_u64(), Some(1), "{report}");
+    // The second step was ended by drifting to its end, as when the event budget runs out.
+    assert_eq!(report["steps"].as_u64(), Some(2), "{report}");
     assert_eq!(report["budget_exhausted"].as_u64(), Some(1), "{report}");
     assert!(
         took < Duration::from_secs(2),
         "the run took {took:?} to stop"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Waits until `path` exists (a run's first checkpoint, put in place whole by a rename).
+fn wait_for(path: &Path) {
+    let start = Instant::now();
+    while !path.exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(300),
+            "{} never came",
+            path.display()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 #[test]
@@ -207,27 +225,49 @@ fn signalled_while_placing(scene_text: &str, placing: &str) {
 #[test]
 fn a_second_signal_ends_the_run_at_once_and_leaves_old_outputs_alone() {
     let dir = scratch_dir("signals", "twice");
-    // Placing a million circles takes seconds: both signals arrive before the first step.
-    let million = "(arena: (size: (1000.0, 1000.0)), spawn: (count: 1000000, radius: (0.1, 0.1)))";
-    let (mut run, report) = run_over_old_report(&dir, million, 100);
+    // 200 000 circles under the course's method: after the first signal the run ends its step
+    // and writes a report, the final state and a checkpoint of them, a fraction of a second to
+    // seconds; the second signal comes while it does, as soon as the run says it heard the first.
+    let scene = "(arena: (size: (1000.0, 1000.0)), effects: (collisions: true), \
+         spawn: (count: 200000, radius: (0.1, 0.1), seed: 1), solver: \"discrete\")";
+    let (mut run, report) = run_over_old_report(&dir, scene, 1_000_000);
+    let (dump, checkpoint) = (dir.join("d.txt"), dir.join("c"));
+    std::fs::write(&dump, "old").unwrap();
     let mut child = run
+        .args(["--dump", dump.to_str().unwrap()])
+        .args(["--checkpoint", checkpoint.to_str().unwrap(), "--every", "1"])
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(1000));
+    wait_for(&checkpoint);
     signal(&child, "INT");
-    std::thread::sleep(Duration::from_millis(100));
+    let stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    // Kept open to the end: a run whose standard error is closed fails on its next line.
+    let mut lines = std::io::BufRead::lines(stderr);
+    let heard = lines
+        .by_ref()
+        .map(Result::unwrap)
+        .find(|line| line.contains("SIGINT: finishing cleanly"));
+    assert!(heard.is_some(), "the run never said it heard the signal");
     signal(&child, "INT");
     let start = Instant::now();
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
     assert!(
-        start.elapsed() < Duration::from_secs(5),
+        start.elapsed() < Duration::from_secs(1),
         "did not end at once"
     );
     assert_eq!(text(&report), "old");
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "a stray file");
+    assert_eq!(text(&dump), "old");
+    // The scene, the two old outputs and the checkpoint of a whole step: nothing half-written.
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["c", "d.txt", "r.json", "scene.ron"], "a stray file");
+    drop(lines);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

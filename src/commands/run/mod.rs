@@ -2,8 +2,8 @@
 //! command line's overrides (solver, or `auto` within a tolerance; step; seed; length), step it
 //! headless with a progress bar on a terminal, print a summary and write the report, the final
 //! state and checkpoints. SIGINT and SIGTERM end it after the current step with all of those
-//! written (a long event-driven step ends at once, through [`StopRequest`]); a second signal
-//! ends it at once.
+//! written (a long event-driven step ends at once, through [`StopRequest`]), saying on standard
+//! error that it heard the signal; a second signal ends it at once.
 
 mod options;
 mod setup;
@@ -259,7 +259,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
 
 /// SIGINT and SIGTERM, caught: the first asks the run to stop after the current step; a second
 /// ends the process at once with 130 / 143, leaving every output as it was (each is replaced
-/// whole or not at all).
+/// whole or not at all, and nothing half-written stays beside it): [`watch_signals`].
 struct Interrupts {
     signal: Arc<AtomicUsize>,
     /// Set by the first signal: what a long step polls ([`StopRequest`]).
@@ -272,13 +272,12 @@ impl Interrupts {
         use signal_hook::flag;
         let once = Arc::new(AtomicBool::new(false));
         let signal = Arc::new(AtomicUsize::new(0));
-        for (number, code) in [(SIGINT, 130), (SIGTERM, 143)] {
-            // Handlers run in the order registered: the exit checks the flag before it is set.
-            flag::register_conditional_shutdown(number, code, Arc::clone(&once))
-                .and_then(|_| flag::register(number, Arc::clone(&once)))
+        for number in [SIGINT, SIGTERM] {
+            flag::register(number, Arc::clone(&once))
                 .and_then(|_| flag::register_usize(number, Arc::clone(&signal), number as usize))
                 .context("installing the signal handlers")?;
         }
+        watch_signals()?;
         Ok(Self { signal, once })
     }
 
@@ -294,6 +293,34 @@ impl Interrupts {
             n => Some(n as i32),
         }
     }
+}
+
+/// Watches SIGINT and SIGTERM from a thread of its own. The first is acknowledged on standard
+/// error (a run finishing a long step or writing millions of circles is otherwise silent until
+/// it ends, and a user or a script waits for that line before deciding on a second signal);
+/// the second ends the process at once with 130 or 143, removing any output half-written
+/// beside its place ([`io::exit_removing_staged`]), so old outputs stay whole and alone.
+fn watch_signals() -> anyhow::Result<()> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
+        .context("installing the signal handlers")?;
+    std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            let mut signals = signals.forever();
+            if let Some(signal) = signals.next() {
+                let name = signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
+                eprintln!(
+                    "moving_circles: {name}: finishing cleanly; a second signal ends the run at \
+                     once, leaving old outputs in place"
+                );
+            }
+            if let Some(signal) = signals.next() {
+                io::exit_removing_staged(128 + signal);
+            }
+        })
+        .context("starting the signal thread")?;
+    Ok(())
 }
 
 /// A first step slower than this is announced with what the whole run will take.
