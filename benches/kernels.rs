@@ -9,12 +9,12 @@ mod common;
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use moving_circles::circle::{CircleState, discs};
-use moving_circles::collide::broad_phase::{CellList, overlapping_pairs};
-use moving_circles::collide::pass::{ContactScratch, resolve_all_contacts};
-use moving_circles::exact::engine::EventEngine;
+use moving_circles::base::circle::{CircleState, discs};
+use moving_circles::collision::broad_phase::{CellList, overlapping_pairs};
+use moving_circles::game::spawn::place_circles;
 use moving_circles::prelude::*;
-use moving_circles::spawn::place_circles;
+use moving_circles::solvers::discrete::pass::{ContactScratch, resolve_all_contacts};
+use moving_circles::solvers::exact::engine::EventEngine;
 
 fn sizes() -> Vec<usize> {
     let mut n = vec![1_000, 10_000, 100_000];

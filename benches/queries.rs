@@ -12,7 +12,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use moving_circles::prelude::*;
-use moving_circles::run::headless_app;
+use moving_circles::tools::run::headless_app;
 
 /// Queries per timed run.
 const QUERIES: usize = 1000;

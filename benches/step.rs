@@ -13,7 +13,7 @@ mod common;
 use bevy::prelude::{App, Entity, With};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use moving_circles::prelude::*;
-use moving_circles::run::headless_app;
+use moving_circles::tools::run::headless_app;
 
 use common::gas;
 
@@ -176,7 +176,7 @@ fn segments(c: &mut Criterion) {
 /// 4 blocks of 20 measured; throughput in pair collisions (engine alone: `exact_density` in
 /// the kernels bench).
 fn eos_point(c: &mut Criterion) {
-    use moving_circles::eos::{EosOptions, measure};
+    use moving_circles::tools::eos::{EosOptions, measure};
     let mut group = c.benchmark_group("eos_point");
     group.sample_size(10);
     for phi in [0.3, 0.7] {

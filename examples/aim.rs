@@ -37,7 +37,7 @@ fn main() -> AppExit {
         )]),
         ..default()
     };
-    let mut app = moving_circles::run::headless_app(config);
+    let mut app = moving_circles::tools::run::headless_app(config);
     for k in -2..=2 {
         let at = DVec2::new(TARGETS_X, 2.0 * k as f64);
         app.world_mut()

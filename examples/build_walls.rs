@@ -26,7 +26,7 @@ fn main() -> AppExit {
         solver: Solver::Soft(4),
         ..default()
     };
-    let mut app = moving_circles::run::headless_app(config);
+    let mut app = moving_circles::tools::run::headless_app(config);
     app.world_mut().spawn((
         Radius(RADIUS),
         Position(DVec2::new(0.0, START_Y)),

@@ -38,7 +38,7 @@ fn main() -> AppExit {
         solver: Solver::Soft(4),
         ..default()
     };
-    let mut app = moving_circles::run::headless_app(config);
+    let mut app = moving_circles::tools::run::headless_app(config);
     app.init_resource::<Score>()
         .add_systems(FixedUpdate, steer.before(CircleSystems::Step))
         .add_systems(FixedUpdate, keep_score.after(CircleSystems::Step));

@@ -27,7 +27,7 @@ struct Tally {
 }
 
 fn main() -> AppExit {
-    let mut app = moving_circles::run::headless_app(CirclesConfig {
+    let mut app = moving_circles::tools::run::headless_app(CirclesConfig {
         spawn: SpawnConfig {
             count: 40,
             radius: (0.15, 0.3),

@@ -33,7 +33,7 @@ struct Hits {
 }
 
 fn main() -> AppExit {
-    let mut app = moving_circles::run::headless_app(CirclesConfig {
+    let mut app = moving_circles::tools::run::headless_app(CirclesConfig {
         arena: Arena::centered(DVec2::new(16.0, 9.0)),
         effects: Effects {
             hit_messages: true,

@@ -1,7 +1,7 @@
 //! Moving, colliding circles on [Bevy](https://bevy.org) 0.19, built the ECS way: an engine you
 //! embed as a plugin group ([`CirclesPlugins`]), five solvers from a cheap discrete step to an
-//! exact event-driven one and a contact solver for piles, and the headless runs and studies the `moving_circles` binary is made
-//! of ([`run`], [`commands`]).
+//! exact event-driven one and a contact solver for piles, and the headless runs and studies the
+//! `moving_circles` binary is made of ([`tools`], [`cli`]).
 //!
 //! # Getting started
 //!
@@ -36,7 +36,7 @@
 //! use bevy::prelude::*;
 //! use moving_circles::prelude::*;
 //!
-//! let mut app = moving_circles::run::headless_app(CirclesConfig {
+//! let mut app = moving_circles::tools::run::headless_app(CirclesConfig {
 //!     effects: Effects { hit_messages: true, ..default() },
 //!     solver: Solver::Exact,
 //!     ..default()
@@ -57,8 +57,8 @@
 //! assert_eq!(app.world().resource::<PairCollisions>().count, 1);
 //! ```
 //!
-//! A scene file says the same in RON; [`Scene::parse`](scene::Scene::parse) reads one and
-//! [`Scene::to_config`](scene::Scene::to_config) checks it, naming the field of any bad value:
+//! A scene file says the same in RON; [`Scene::parse`](tools::scene::Scene::parse) reads one and
+//! [`Scene::to_config`](tools::scene::Scene::to_config) checks it, naming the field of any bad value:
 //!
 //! ```
 //! use moving_circles::prelude::*;
@@ -73,7 +73,7 @@
 //! .unwrap();
 //! let config = scene.to_config("v.ron").unwrap();
 //! assert_eq!(config.segments.0.len(), 2);
-//! let mut app = moving_circles::run::headless_app(config);
+//! let mut app = moving_circles::tools::run::headless_app(config);
 //! for _ in 0..30 {
 //!     app.update();
 //! }
@@ -85,55 +85,37 @@
 //!
 //! # Solvers
 //!
-//! Picked by [`Solver`](config::Solver), per scene, on the command line or at runtime:
+//! Picked by [`Solver`](base::config::Solver), per scene, on the command line or at runtime:
 //!
 //! | solver | what it does |
 //! |---|---|
-//! | `discrete` | moves, pushes overlapping pairs apart and applies the elastic impulse ([`collide`]): the cheapest, but circles overlap and fast pairs tunnel. |
+//! | `discrete` | moves, pushes overlapping pairs apart and applies the elastic impulse ([`solvers::discrete`]): the cheapest, but circles overlap and fast pairs tunnel. |
 //! | `substeps=N` | runs `discrete` N times a step with dt/N: errors shrink roughly like 1/N while the cost grows like N. |
-//! | `swept` | processes each step's pair and wall hits in time order at their times of impact ([`exact`]), afresh every step: no tunnelling, no overlap. |
-//! | `exact` | keeps one event-driven engine ([`exact::engine`]) across steps: the reference, exact to rounding, paying per collision rather than per step. |
-//! | `soft` | the contact solver for games and piles ([`soft`]): persistent speculative contacts made soft springs, warm started and solved in 4 substeps (`soft=N`: N) with relaxation and a restitution pass, so stacks and piles rest. |
+//! | `swept` | processes each step's pair and wall hits in time order at their times of impact ([`solvers::exact`]), afresh every step: no tunnelling, no overlap. |
+//! | `exact` | keeps one event-driven engine ([`solvers::exact::engine`]) across steps: the reference, exact to rounding, paying per collision rather than per step. |
+//! | `soft` | the contact solver for games and piles ([`solvers::soft`]): persistent speculative contacts made soft springs, warm started and solved in 4 substeps (`soft=N`: N) with relaxation and a restitution pass, so stacks and piles rest. |
 //!
 //! # Modules
 //!
-//! The plugin group and what it is made of:
-//! - [`schedule`]: the [`CircleSystems`] sets, the step schedules and [`StepPlugin`];
-//! - [`config`]: [`CirclesConfig`] and its parts, with the limits on every value;
-//! - [`components`]: the components a circle is made of;
-//! - [`spawn`]: placing circles at startup, on a respawn and one at a time;
-//! - [`integrate`]: free flight;
-//! - [`forces`]: gravity and drag;
-//! - [`boundary`]: walls, periodic edges and segment walls;
-//! - [`collide`]: circle-circle collisions of the discrete solvers, the broad phase and the contact kernel;
-//! - [`exact`]: the continuous solvers, `swept` and `exact`, on one event engine;
-//! - [`soft`]: the contact solver, `soft`;
-//! - [`sleep`]: circles at rest fall asleep under the time-stepped solvers;
-//! - [`effects`]: the registry that keeps exactly the effects a scene calls for in the schedule;
-//! - [`hits`]: collision messages;
-//! - [`diagnostics`]: energy, momentum and pressure after each step;
-//! - [`transform_sync`]: each circle's `Transform` follows its position, interpolated between steps;
-//! - [`query`]: spatial queries for game code: points, overlaps, ray and circle casts;
-//! - [`render`]: the window, sprites, HUD, keys and the live panel (feature `render`).
-//!
-//! The plain data the kernels work on:
-//! - [`arena`]: the region the circles live in, walls or periodic;
-//! - [`circle`]: one circle's state outside the ECS;
-//! - [`segment`]: segment walls and the cells they pass near;
-//! - [`error`]: the errors of bad input.
-//!
-//! Files, runs and studies:
-//! - [`scene`]: scene files and particle files, read and checked;
-//! - [`io`]: writing outputs atomically and reading inputs of untrusted size;
-//! - [`run`]: the headless app and the one stepping loop;
-//! - [`checkpoint`]: a run's whole state, to resume bit for bit;
-//! - [`commands`] (feature `cli`): the work behind each `moving_circles` command;
-//! - [`accuracy`]: the accuracy study of every solver against `exact`;
-//! - [`eos`]: the hard-disk equation of state.
-//!
-//! Internal to the crate (see `docs/architecture.md`): the uniform grid every part that buckets
-//! circles shares, triangular lattices for dense states, the one physical range of every input
-//! value (its limits are re-exported by [`config`]) and what the studies' figures share.
+//! Seven layers, each importing only from those below it (`docs/architecture.md` has the map,
+//! file by file):
+//! - [`base`]: what every layer shares: the arena, a circle's state and its components, segment
+//!   walls, the configuration ([`CirclesConfig`]) with the limits on every value, hit messages
+//!   and counters, errors;
+//! - [`collision`]: the collision layer, free of the ECS: times of impact, roots, impulses
+//!   smooth and rough, the broad phase, pair lists, overlap measures;
+//! - [`step`]: what every solver's step shares: the [`CircleSystems`] sets and step schedules,
+//!   the registry that keeps exactly the effects a scene calls for, gravity and drag, free
+//!   flight, walls, periodic edges and segment walls, sleeping;
+//! - [`solvers`]: one folder a solver: `discrete` and `substeps=N`, `swept` and `exact` on one
+//!   event engine, and the contact solver `soft`;
+//! - [`game`]: the plugin group [`CirclesPlugins`], spawning, sensors, spatial queries, each
+//!   circle's `Transform` following its position, and the diagnostics (energy, momentum,
+//!   pressure);
+//! - [`tools`]: scene and particle files, the headless app and the one stepping loop,
+//!   checkpoints, the accuracy study and the equation of state;
+//! - [`render`] (feature `render`): the window, sprites, HUD, keys and the live panel;
+//! - [`cli`] (feature `cli`): the work behind each `moving_circles` command.
 //!
 //! # The guide
 //!
@@ -154,178 +136,60 @@ struct ReadmeDoctests;
 #[doc = include_str!("../docs/embedding.md")]
 struct EmbeddingDoctests;
 
-pub mod accuracy;
-pub mod arena;
-pub mod boundary;
-pub mod checkpoint;
-pub mod circle;
-pub mod collide;
-pub mod collision_layers;
+pub mod base;
 #[cfg(feature = "cli")]
-pub mod commands;
-pub mod components;
-pub mod config;
-pub mod diagnostics;
-pub mod effects;
-pub mod eos;
-pub mod error;
-pub mod exact;
-#[cfg(feature = "cli")]
-mod figure;
-pub mod forces;
-mod grid;
-pub mod hits;
-pub mod integrate;
-pub mod io;
-mod lattice;
-pub mod query;
-mod range;
+pub mod cli;
+pub mod collision;
+pub mod game;
 #[cfg(feature = "render")]
 pub mod render;
-pub mod run;
-pub mod scene;
-pub mod schedule;
-pub mod segment;
-pub mod sensor;
-pub mod sleep;
-pub mod soft;
-pub mod spawn;
-pub mod transform_sync;
-pub mod vector;
+pub mod solvers;
+pub mod step;
+pub mod tools;
 
-use bevy::app::{PluginGroup, PluginGroupBuilder};
-
-use boundary::{PeriodicPlugin, SegmentsPlugin, WallsPlugin};
-use collide::CollidePlugin;
-use config::CirclesConfig;
-use diagnostics::DiagnosticsPlugin;
-use exact::ContinuousPlugin;
-use forces::{DragPlugin, GravityPlugin};
-use integrate::IntegratePlugin;
-use query::SpatialQueryPlugin;
-use schedule::StepPlugin;
-use sensor::SensorPlugin;
-use sleep::SleepPlugin;
-use soft::SoftPlugin;
-use spawn::SpawnPlugin;
-use transform_sync::TransformSyncPlugin;
+pub use game::plugins::CirclesPlugins;
 
 /// The common imports: the plugin group and its parts, components, configuration, sets and
 /// what the simulation measures.
 pub mod prelude {
     pub use crate::CirclesPlugins;
-    pub use crate::arena::{Arena, Boundary};
-    pub use crate::boundary::{PeriodicPlugin, SegmentsPlugin, WallCollisions, WallsPlugin};
-    pub use crate::circle::CircleState;
-    pub use crate::collide::{CollidePlugin, PairCollisions};
-    pub use crate::collision_layers::{
+    pub use crate::base::arena::{Arena, Boundary};
+    pub use crate::base::circle::CircleState;
+    pub use crate::base::collision_layers::{
         CollisionLayers, OverlapEnded, OverlapStarted, Sensor, SensorOverlaps,
     };
-    pub use crate::components::{
+    pub use crate::base::components::{
         AngularVelocity, Friction, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep,
         Tint, Velocity,
     };
-    pub use crate::config::{
+    pub use crate::base::config::{
         CirclesConfig, Combine, DropConfig, Effects, MassModel, Placement, SleepConfig, SoftConfig,
         Solver, SpawnConfig,
     };
-    pub use crate::diagnostics::{CircleDiagnostics, DiagnosticsPlugin, Measuring};
-    pub use crate::effects::Effect;
-    pub use crate::exact::{ContinuousPlugin, EventBudget};
-    pub use crate::forces::{DragPlugin, GravityPlugin};
-    pub use crate::hits::{ArenaWall, CircleHit, Wall, WallHit};
-    pub use crate::integrate::IntegratePlugin;
-    pub use crate::query::{CastHit, QueryFilter, SpatialQuery, SpatialQueryPlugin, Target};
-    pub use crate::scene::Scene;
-    pub use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals};
-    pub use crate::segment::{Segment, Segments};
-    pub use crate::sensor::SensorPlugin;
-    pub use crate::sleep::{SleepPlugin, Sleeping};
-    pub use crate::soft::SoftPlugin;
-    pub use crate::spawn::{Respawn, SpawnPlugin, SpawnReport};
-    pub use crate::transform_sync::{DefaultSmoothing, Smoothing, TransformSyncPlugin};
+    pub use crate::base::hits::PairCollisions;
+    pub use crate::base::hits::{ArenaWall, CircleHit, Wall, WallHit};
+    pub use crate::base::segment::{Segment, Segments};
+    pub use crate::game::diagnostics::{CircleDiagnostics, DiagnosticsPlugin, Measuring};
+    pub use crate::game::query::{CastHit, QueryFilter, SpatialQuery, SpatialQueryPlugin, Target};
+    pub use crate::game::sensor::SensorPlugin;
+    pub use crate::game::spawn::{Respawn, SpawnPlugin, SpawnReport};
+    pub use crate::game::transform_sync::{DefaultSmoothing, Smoothing, TransformSyncPlugin};
+    pub use crate::solvers::discrete::CollidePlugin;
+    pub use crate::solvers::exact::{ContinuousPlugin, EventBudget};
+    pub use crate::solvers::soft::SoftPlugin;
+    pub use crate::step::boundary::{PeriodicPlugin, SegmentsPlugin, WallCollisions, WallsPlugin};
+    pub use crate::step::effects::Effect;
+    pub use crate::step::forces::{DragPlugin, GravityPlugin};
+    pub use crate::step::integrate::IntegratePlugin;
+    pub use crate::step::schedule::{
+        CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals,
+    };
+    pub use crate::step::sleep::{SleepPlugin, Sleeping};
+    pub use crate::tools::scene::Scene;
 }
 
-pub use components::{
+pub use base::components::{
     AngularVelocity, Friction, Inertia, Mass, Position, Radius, Restitution, Rotation, Tint,
     Velocity,
 };
-pub use schedule::CircleSystems;
-
-/// The simulation as a plugin group: [`StepPlugin`] (first: the others build on it),
-/// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
-/// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
-/// [`ContinuousPlugin`] (the `swept` and `exact` solvers), [`SoftPlugin`] (the `soft` contact
-/// solver), [`SleepPlugin`], [`SensorPlugin`] (what overlaps each
-/// [`Sensor`](collision_layers::Sensor)), [`DiagnosticsPlugin`], [`TransformSyncPlugin`] (each circle's
-/// `Transform`, if it has one, follows its [`Position`] smoothly between fixed steps) and
-/// [`SpatialQueryPlugin`] (the index behind [`SpatialQuery`](query::SpatialQuery)).
-///
-/// An effect plugin schedules its systems only when the configuration calls for the effect,
-/// so an effect a scene does not ask for costs nothing; it stays registered, so a reloaded
-/// scene that asks for it gets its systems. Parts can be switched off or replaced the Bevy way:
-///
-/// ```no_run
-/// # use bevy::prelude::*;
-/// # use moving_circles::prelude::*;
-/// App::new().add_plugins((
-///     MinimalPlugins,
-///     CirclesPlugins::default().build().disable::<SpawnPlugin>(),
-/// ));
-/// ```
-#[derive(Clone, Debug, Default)]
-pub struct CirclesPlugins {
-    /// What to simulate and how.
-    pub config: CirclesConfig,
-}
-
-impl CirclesPlugins {
-    /// The plugin group for `config`.
-    pub fn new(config: CirclesConfig) -> Self {
-        Self { config }
-    }
-}
-
-impl PluginGroup for CirclesPlugins {
-    fn build(self) -> PluginGroupBuilder {
-        let CirclesConfig {
-            arena,
-            spawn,
-            solver,
-            effects,
-            dt,
-            circles,
-            segments,
-            drop,
-            soft,
-        } = self.config;
-        PluginGroupBuilder::start::<Self>()
-            .add(StepPlugin {
-                arena,
-                solver,
-                effects,
-                dt,
-                segments,
-                soft,
-            })
-            .add(SpawnPlugin {
-                config: spawn,
-                circles,
-                drop,
-            })
-            .add(IntegratePlugin)
-            .add(GravityPlugin)
-            .add(DragPlugin)
-            .add(SegmentsPlugin)
-            .add(WallsPlugin)
-            .add(PeriodicPlugin)
-            .add(CollidePlugin)
-            .add(ContinuousPlugin)
-            .add(SoftPlugin)
-            .add(SleepPlugin)
-            .add(SensorPlugin)
-            .add(DiagnosticsPlugin)
-            .add(TransformSyncPlugin::default())
-            .add(SpatialQueryPlugin)
-    }
-}
+pub use step::schedule::CircleSystems;

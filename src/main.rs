@@ -1,5 +1,5 @@
 //! The `moving_circles` binary: parses the command line and calls the library's
-//! [`commands`](moving_circles::commands) — the app (feature `render`) by default, or the
+//! [`commands`](moving_circles::cli) — the app (feature `render`) by default, or the
 //! headless `run`, `accuracy` and `systems` — and turns an error into one line on stderr and a
 //! non-zero exit.
 
@@ -8,12 +8,12 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
-use moving_circles::arena::Boundary;
-use moving_circles::commands;
-use moving_circles::commands::run::{Input, Length, RunOptions, SolverChoice};
-use moving_circles::commands::run::{MAX_STEPS, MAX_THREADS};
-use moving_circles::config::{DT_RANGE, Placement, Solver};
-use moving_circles::io::printable;
+use moving_circles::base::arena::Boundary;
+use moving_circles::base::config::{DT_RANGE, Placement, Solver};
+use moving_circles::base::io::printable;
+use moving_circles::cli;
+use moving_circles::cli::run::{Input, Length, RunOptions, SolverChoice};
+use moving_circles::cli::run::{MAX_STEPS, MAX_THREADS};
 
 /// Moving, colliding circles. Without a subcommand, opens the app.
 #[derive(Parser, Debug)]
@@ -277,11 +277,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Run(args)) => RunOptions::try_from(*args)
-            .and_then(commands::run::run)
+            .and_then(cli::run::run)
             .map(|finished| finished.exit_code()),
-        Some(Command::Systems { scene }) => commands::systems::systems(&scene).map(|()| 0),
+        Some(Command::Systems { scene }) => cli::systems::systems(&scene).map(|()| 0),
         Some(Command::Accuracy { out, scenes, quick }) => {
-            commands::accuracy::accuracy(&out, &scenes, quick).map(|()| 0)
+            cli::accuracy::accuracy(&out, &scenes, quick).map(|()| 0)
         }
         Some(Command::Eos {
             out,
@@ -292,16 +292,16 @@ fn main() -> ExitCode {
             block,
             seed,
         }) => {
-            let options = moving_circles::eos::EosOptions {
+            let options = moving_circles::tools::eos::EosOptions {
                 n,
                 area_fractions: area_fractions
-                    .unwrap_or_else(|| moving_circles::eos::DEFAULT_AREA_FRACTIONS.to_vec()),
+                    .unwrap_or_else(|| moving_circles::tools::eos::DEFAULT_AREA_FRACTIONS.to_vec()),
                 equilibrate,
                 blocks,
                 block,
                 seed,
             };
-            commands::eos::eos(&options, &out).map(|()| 0)
+            cli::eos::eos(&options, &out).map(|()| 0)
         }
         None => open_app(cli.app).map(|()| 0),
     };
@@ -316,7 +316,7 @@ fn main() -> ExitCode {
 
 #[cfg(feature = "render")]
 fn open_app(args: AppArgs) -> anyhow::Result<()> {
-    let options = commands::app::AppOptions {
+    let options = cli::app::AppOptions {
         scene: args.scene,
         count: args.count,
         seed: args.seed,
@@ -324,7 +324,7 @@ fn open_app(args: AppArgs) -> anyhow::Result<()> {
         screenshot: args.screenshot.map(|path| (path, args.frames)),
         panel: args.panel,
     };
-    if !commands::app::open(options)? {
+    if !cli::app::open(options)? {
         bail!("the app ended with an error");
     }
     Ok(())

@@ -10,8 +10,8 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::error::FieldError;
-use crate::range::{MAX_MAGNITUDE, in_range};
+use crate::base::error::FieldError;
+use crate::base::range::{MAX_MAGNITUDE, in_range};
 
 /// What happens at the edges of the arena.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -59,7 +59,7 @@ impl FromStr for Boundary {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::arena::{Arena, Boundary};
+/// use moving_circles::base::arena::{Arena, Boundary};
 ///
 /// let walls = Arena::centered(DVec2::new(4.0, 2.0));
 /// assert_eq!(walls.offset(DVec2::new(-1.9, 0.0), DVec2::new(1.9, 0.0)).x, 3.8);

@@ -5,7 +5,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{AngularVelocity, Mass, Position, Radius, Rotation, Tint, Velocity};
+use crate::base::components::{AngularVelocity, Mass, Position, Radius, Rotation, Tint, Velocity};
 
 /// The moment of inertia of a uniform disc of `mass` and `radius` about its centre: `m r² / 2`,
 /// what every circle turns with.
@@ -24,7 +24,7 @@ pub fn disc_inverse_inertia(inv_mass: f64, radius: f64) -> f64 {
 }
 
 /// The moment of inertia a circle turns with: its `own`
-/// ([`Inertia`](crate::components::Inertia)) or a uniform disc's.
+/// ([`Inertia`](crate::base::components::Inertia)) or a uniform disc's.
 #[inline]
 pub fn inertia(own: Option<f64>, mass: f64, radius: f64) -> f64 {
     own.unwrap_or_else(|| disc_inertia(mass, radius))
@@ -49,7 +49,7 @@ pub fn inverse_inertia(own: Option<f64>, inv_mass: f64, radius: f64) -> f64 {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::circle::CircleState;
+/// use moving_circles::base::circle::CircleState;
 ///
 /// let heavy = CircleState::new(DVec2::ZERO, DVec2::X, 0.5).with_mass(f64::INFINITY);
 /// assert_eq!(heavy.inv_mass(), 0.0); // immovable: collision kernels need no special case

@@ -31,7 +31,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Position, Radius};
+use crate::base::components::{Position, Radius};
 
 /// The groups a circle belongs to (`memberships`) and the groups it meets (`filters`), one bit
 /// per group, up to 32 groups. Two circles meet when each is in a group the other meets
@@ -100,8 +100,8 @@ impl Default for CollisionLayers {
 
 /// Makes a circle a sensor: it gives and takes no impulse (no solver pairs it with anything),
 /// still moves with its velocity and still bounces off walls unless static or kinematic
-/// ([`Mass::IMMOVABLE`](crate::components::Mass::IMMOVABLE)). After each fixed step, the
-/// [`SensorPlugin`](crate::sensor::SensorPlugin) lists the circles overlapping it in its
+/// ([`Mass::IMMOVABLE`](crate::base::components::Mass::IMMOVABLE)). After each fixed step, the
+/// [`SensorPlugin`](crate::game::sensor::SensorPlugin) lists the circles overlapping it in its
 /// [`SensorOverlaps`] (those its own [`CollisionLayers`], if it has them, meet; never another
 /// sensor) and writes an [`OverlapStarted`] or [`OverlapEnded`] message for each that came or
 /// went.

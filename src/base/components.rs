@@ -32,7 +32,7 @@ pub struct Radius(pub f64);
 ///   it; circles bounce off it as off a wall.
 /// - a **kinematic** circle (a paddle): immovable, moving with the [`Velocity`] your code sets
 ///   (every frame if you like). It pushes the others and nothing pushes it back; what it gave
-///   them is counted in [`PairCollisions`](crate::collide::PairCollisions)
+///   them is counted in [`PairCollisions`](crate::base::hits::PairCollisions)
 ///   (`immovable_work`, `immovable_impulse`). Like any circle it is kept inside the walls.
 ///
 /// Immovable circles carry no energy or momentum in the diagnostics, and gravity and drag
@@ -82,7 +82,7 @@ impl Mass {
 
 /// A circle's own coefficient of restitution, in `[0, 1]`; without it a circle takes the
 /// scene's (`effects.restitution` against circles, `effects.wall_restitution` against walls).
-/// Two values meet as their minimum ([`combine_restitution`](crate::collide::contact::combine_restitution)),
+/// Two values meet as their minimum ([`combine_restitution`](crate::collision::contact::combine_restitution)),
 /// against other circles and walls alike, under every solver.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Debug)]
@@ -144,7 +144,7 @@ impl Rotation {
 pub struct Inertia(pub f64);
 
 /// A circle's own friction coefficient (Coulomb's μ, from 0 to
-/// [`MAX_FRICTION`](crate::config::MAX_FRICTION), as the scene's: a checkpoint of a circle with
+/// [`MAX_FRICTION`](crate::base::config::MAX_FRICTION), as the scene's: a checkpoint of a circle with
 /// more is refused when read back); without it a circle takes
 /// the scene's (`effects.friction` against circles, `effects.wall_friction` against walls).
 /// Two values meet as the scene's `effects.friction_combine` says (their geometric mean by
@@ -169,7 +169,7 @@ impl Default for Tint {
 /// it is by every solver, at no cost per step, and acts as an immovable circle at rest for the
 /// others until it is woken: by a hit, by your code writing its [`Position`] or [`Velocity`],
 /// or by a change of the effects, the arena, the segment walls or the solver. Only scenes with
-/// gravity sleep ([`SleepConfig`](crate::config::SleepConfig)).
+/// gravity sleep ([`SleepConfig`](crate::base::config::SleepConfig)).
 #[derive(
     Component, Reflect, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
 )]

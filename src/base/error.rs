@@ -4,13 +4,13 @@
 
 use std::fmt;
 
-use crate::io::printable;
+use crate::base::io::printable;
 
 /// A configuration value that cannot be used: the field (as a path like `spawn.radius`) and
 /// what is wrong with it.
 ///
 /// ```
-/// use moving_circles::config::Effects;
+/// use moving_circles::base::config::Effects;
 ///
 /// let effects = Effects { restitution: 1.5, ..Effects::default() };
 /// let err = effects.check().unwrap_err();

@@ -1,6 +1,6 @@
-//! Collision messages: a [`CircleHit`] per circle-circle impulse and a [`WallHit`] per hit on an
-//! arena wall or a segment wall, written by whichever solver made the hit when the scene opts in
-//! (`effects.hit_messages`).
+//! Collision messages and counters: a [`CircleHit`] per circle-circle impulse and a [`WallHit`]
+//! per hit on an arena wall or a segment wall, written by whichever solver made the hit when the
+//! scene opts in (`effects.hit_messages`), and the [`PairCollisions`] every solver counts.
 //!
 //! The kernels (the discrete contact pass, the wall reflection, the event engine) record hits
 //! with circle indices into a [`HitLog`]; the solver's system turns indices into entities and
@@ -11,7 +11,7 @@
 //!
 //! ```
 //! use bevy::prelude::*;
-//! use moving_circles::hits::CircleHit;
+//! use moving_circles::base::hits::CircleHit;
 //!
 //! fn hard_hits(mut hits: MessageReader<CircleHit>) {
 //!     for hit in hits.read().filter(|h| h.impulse > 5.0) {
@@ -23,7 +23,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
+use crate::base::arena::Arena;
 
 /// One circle-circle collision: the impulse the solver applied to a pair.
 ///
@@ -98,7 +98,7 @@ impl ArenaWall {
 pub enum Wall {
     /// An edge of the arena.
     Arena(ArenaWall),
-    /// A segment wall, by its index in [`Segments`](crate::segment::Segments).
+    /// A segment wall, by its index in [`Segments`](crate::base::segment::Segments).
     Segment(u32),
 }
 
@@ -176,5 +176,37 @@ impl HitLog {
             normal_speed: h.normal_speed,
             count: h.count,
         }));
+    }
+}
+
+/// Circle-circle collisions since the last (re)spawn, under any solver.
+#[derive(
+    Resource, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
+)]
+pub struct PairCollisions {
+    /// Impulses applied.
+    pub count: u64,
+    /// Collisional virial `Σ (r_a + r_b) · j` over those impulses (for the pressure).
+    pub virial: f64,
+    /// Kinetic energy that immovable (static or kinematic) circles gave the others: with
+    /// elastic hits, the energy a kinematic paddle injected (a static peg gives none).
+    pub immovable_work: f64,
+    /// Momentum that immovable circles gave the others.
+    pub immovable_impulse: bevy::math::DVec2,
+}
+
+impl PairCollisions {
+    /// The collisions between `earlier` and these counters (all zero across a respawn, which
+    /// restarts the counters).
+    pub fn since(&self, earlier: &PairCollisions) -> PairCollisions {
+        if self.count < earlier.count {
+            return PairCollisions::default();
+        }
+        PairCollisions {
+            count: self.count - earlier.count,
+            virial: self.virial - earlier.virial,
+            immovable_work: self.immovable_work - earlier.immovable_work,
+            immovable_impulse: self.immovable_impulse - earlier.immovable_impulse,
+        }
     }
 }

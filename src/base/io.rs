@@ -103,7 +103,7 @@ impl<R: BufRead> Lines<R> {
 ///
 /// ```
 /// let path = std::env::temp_dir().join(format!("mc-doc-{}.txt", std::process::id()));
-/// moving_circles::io::write_atomically(&path, b"whole").unwrap();
+/// moving_circles::base::io::write_atomically(&path, b"whole").unwrap();
 /// assert_eq!(std::fs::read(&path).unwrap(), b"whole");
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
@@ -302,7 +302,7 @@ fn kind_of(file_type: &std::fs::FileType) -> &'static str {
 /// retitle the terminal or forge a line of output. Other text, non-ASCII included, is kept.
 ///
 /// ```
-/// use moving_circles::io::printable;
+/// use moving_circles::base::io::printable;
 ///
 /// assert_eq!(printable("ok × 2"), "ok × 2");
 /// assert_eq!(printable("a\u{1b}]0;pwned\u{7}b\n"), "a\\u{1b}]0;pwned\\u{7}b\\n");

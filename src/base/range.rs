@@ -5,7 +5,7 @@
 
 use bevy::math::DVec2;
 
-use crate::error::FieldError;
+use crate::base::error::FieldError;
 
 /// Largest magnitude of any length, coordinate, speed, mass, density, acceleration or rate an
 /// input may give. One rule for scene files, particle files, spawn rules and the command line:

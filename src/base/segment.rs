@@ -7,10 +7,10 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::arena::Arena;
-use crate::error::FieldError;
-use crate::grid::Grid;
-use crate::range::check_vector;
+use crate::base::arena::Arena;
+use crate::base::error::FieldError;
+use crate::base::grid::Grid;
+use crate::base::range::check_vector;
 
 /// Most segments a scene may declare: enough for detailed mazes and boards, few enough that the
 /// per-cell lists stay small.
@@ -35,7 +35,7 @@ impl Segment {
     ///
     /// ```
     /// use bevy::math::DVec2;
-    /// use moving_circles::segment::Segment;
+    /// use moving_circles::base::segment::Segment;
     ///
     /// let s = Segment::new(DVec2::ZERO, DVec2::new(2.0, 0.0));
     /// assert_eq!(s.closest_point(DVec2::new(0.5, 3.0)), DVec2::new(0.5, 0.0));
@@ -91,7 +91,7 @@ impl Segment {
 }
 
 /// The segment walls of the arena, in the order the scene gives them (a
-/// [`WallHit`](crate::hits::WallHit) names one by its index here). Empty by default: no segment
+/// [`WallHit`](crate::base::hits::WallHit) names one by its index here). Empty by default: no segment
 /// effect is scheduled then.
 #[derive(Resource, Reflect, Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[reflect(Resource, Debug)]
@@ -103,7 +103,7 @@ impl Segments {
     ///
     /// ```
     /// use bevy::math::DVec2;
-    /// use moving_circles::segment::Segments;
+    /// use moving_circles::base::segment::Segments;
     ///
     /// let v = Segments::from_polylines(&[vec![DVec2::new(-1.0, 1.0), DVec2::ZERO, DVec2::ONE]]);
     /// assert_eq!(v.0.len(), 2);
@@ -126,7 +126,7 @@ impl Segments {
     /// and an arena that is not periodic (there a segment would have to wrap). Fields are
     /// named `segments[k].a` / `.b`, `k` counting segments as a [`WallHit`] does.
     ///
-    /// [`WallHit`]: crate::hits::WallHit
+    /// [`WallHit`]: crate::base::hits::WallHit
     pub fn check(&self, arena: &Arena) -> Result<(), FieldError> {
         if self.0.len() > MAX_SEGMENTS {
             let n = self.0.len();

@@ -4,10 +4,10 @@
 
 use std::path::PathBuf;
 
-use crate::config::{CirclesConfig, Solver};
-use crate::io::printable;
+use crate::base::config::{CirclesConfig, Solver};
+use crate::base::io::printable;
 use crate::render::{self, NO_WINDOW_HINT};
-use crate::scene::{Scene, classic};
+use crate::tools::scene::{Scene, classic};
 
 /// What the app is opened on.
 #[derive(Clone, Debug, Default)]

@@ -2,11 +2,11 @@
 
 use std::path::Path;
 
-use crate::config::Solver;
-use crate::io::say;
-use crate::run::headless_app;
-use crate::scene::Scene;
-use crate::schedule::scheduled_systems;
+use crate::base::config::Solver;
+use crate::base::io::say;
+use crate::step::schedule::scheduled_systems;
+use crate::tools::run::headless_app;
+use crate::tools::scene::Scene;
 
 /// Prints the systems the scene at `scene` schedules, for the step schedule its solver runs.
 pub fn systems(scene: &Path) -> anyhow::Result<()> {

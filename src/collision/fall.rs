@@ -8,7 +8,7 @@
 use bevy::math::DVec2;
 
 use super::roots::{first_entering_root, quadratic_roots};
-use crate::segment::Segment;
+use crate::base::segment::Segment;
 
 /// When a point at `x` moving at `v` with acceleration `acc` along one axis first leaves
 /// `[lo, hi]`: `(time, high)`, `high` for leaving through `hi`. A point already past a bound
@@ -16,7 +16,7 @@ use crate::segment::Segment;
 /// bounds) and for cell crossings (the cell's edges).
 ///
 /// ```
-/// use moving_circles::exact::fall::exit_time;
+/// use moving_circles::collision::fall::exit_time;
 ///
 /// // Dropped at rest from 0.5 under -4: it lands on 0 at τ = 0.5.
 /// let (t, high) = exit_time(0.5, 0.0, -4.0, 0.0, 1.0).unwrap();
@@ -70,7 +70,7 @@ pub fn exit_time(x: f64, v: f64, acc: f64, lo: f64, hi: f64) -> Option<(f64, boo
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::exact::fall::falling_pair_time;
+/// use moving_circles::collision::fall::falling_pair_time;
 ///
 /// // A ball 2 above a peg, radii summing to 1, dropped at rest under g = 2: it falls 1 in 1.
 /// let (dp, dv, da) = (DVec2::new(0.0, -2.0), DVec2::ZERO, DVec2::new(0.0, 2.0));

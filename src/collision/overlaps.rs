@@ -6,8 +6,8 @@ use bevy::math::DVec2;
 
 use super::broad_phase::scan::fold_pairs_by_band;
 use super::broad_phase::{CellList, needs_levels, overlapping_pairs, radius_range};
-use crate::arena::Arena;
-use crate::collision_layers::{CollisionLayers, pair_meets};
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{CollisionLayers, pair_meets};
 
 /// Every overlapping pair `(i, j, depth)` of `circles` (centre, radius), `i < j`, sorted, with
 /// `depth` the overlap distance `r_i + r_j − |x_j − x_i|` in `arena`, among the pairs that
@@ -15,8 +15,8 @@ use crate::collision_layers::{CollisionLayers, pair_meets};
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::arena::Arena;
-/// use moving_circles::collide::overlaps::overlapping_circles;
+/// use moving_circles::base::arena::Arena;
+/// use moving_circles::collision::overlaps::overlapping_circles;
 ///
 /// let circles = [(DVec2::ZERO, 0.5), (DVec2::new(0.75, 0.0), 0.5)];
 /// assert_eq!(overlapping_circles(&circles, &Arena::default(), &[]), [(0, 1, 0.25)]);
@@ -99,7 +99,7 @@ impl Overlaps {
     }
 
     /// [`Overlaps::measure`] of circles given as centre, radius and layers (as
-    /// [`solver_layers`](crate::collision_layers::solver_layers) gives them).
+    /// [`solver_layers`](crate::base::collision_layers::solver_layers) gives them).
     pub fn measure_layered(
         circles: impl Iterator<Item = (DVec2, f64, CollisionLayers)>,
         arena: &Arena,
@@ -160,7 +160,7 @@ mod tests {
             let periodic = Arena {
                 min: DVec2::ZERO,
                 max: DVec2::splat(side),
-                boundary: crate::arena::Boundary::Periodic,
+                boundary: crate::base::arena::Boundary::Periodic,
             };
             for arena in [Arena::default(), periodic] {
                 let listed = overlapping_circles(&circles, &arena, &layers);

@@ -10,7 +10,7 @@
 use bevy::math::DVec2;
 
 use super::broad_phase::{CellList, needs_levels, overlapping_pairs, radius_range};
-use crate::arena::Arena;
+use crate::base::arena::Arena;
 
 /// How far past its reach (as a fraction of it) a list is made to hold a circle's pairs, for
 /// callers with no reason to choose otherwise: a settled circle moves so little that the list
@@ -245,7 +245,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
 
     /// What a fresh broad phase finds, sorted.
     fn fresh(arena: &Arena, circles: &[(DVec2, f64)]) -> Vec<(usize, usize)> {

@@ -7,14 +7,14 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::boundary::WallCollisions;
-use crate::circle::inertia;
-use crate::collide::PairCollisions;
-use crate::components::{AngularVelocity, Inertia, Mass, Position, Radius, Velocity};
-use crate::config::{DropConfig, Effects, SpawnConfig};
-use crate::schedule::{CircleSystems, StepTotals};
-use crate::spawn::{Dropped, SpawnReport, nth_drop};
+use crate::base::arena::Arena;
+use crate::base::circle::inertia;
+use crate::base::components::{AngularVelocity, Inertia, Mass, Position, Radius, Velocity};
+use crate::base::config::{DropConfig, Effects, SpawnConfig};
+use crate::base::hits::PairCollisions;
+use crate::game::spawn::{Dropped, SpawnReport, nth_drop};
+use crate::step::boundary::WallCollisions;
+use crate::step::schedule::{CircleSystems, StepTotals};
 
 /// Pressure as the compressibility factor `z = P·A / (N·kT)`, with `kT` the mean kinetic energy
 /// per circle (2D), measured two ways over the time since the last reset.
@@ -324,7 +324,7 @@ fn take_baseline(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
 
     #[test]
     fn a_change_from_nothing_or_next_to_nothing_is_finite() {

@@ -10,7 +10,7 @@
 //! use bevy::prelude::*;
 //! use moving_circles::prelude::*;
 //!
-//! let mut app = moving_circles::run::headless_app(CirclesConfig::default());
+//! let mut app = moving_circles::tools::run::headless_app(CirclesConfig::default());
 //! let zone = app.world_mut().spawn((
 //!     Radius(1.0),
 //!     Position(DVec2::ZERO),
@@ -34,13 +34,13 @@ use bevy::ecs::schedule::common_conditions::any_with_component;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::collision_layers::{
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{
     CollisionLayers, OverlapEnded, OverlapStarted, Sensor, SensorOverlaps,
 };
-use crate::components::{Position, Radius};
-use crate::query::index::CircleIndex;
-use crate::schedule::CircleSystems;
+use crate::base::components::{Position, Radius};
+use crate::game::query::index::CircleIndex;
+use crate::step::schedule::CircleSystems;
 
 /// Finds what overlaps each sensor after every fixed step, in [`CircleSystems::Sensors`]
 /// (part of [`CirclesPlugins`](crate::CirclesPlugins)), and registers [`CollisionLayers`] and
@@ -196,7 +196,7 @@ fn changes(before: &[Entity], now: &[Entity]) -> Vec<Change> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

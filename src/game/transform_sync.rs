@@ -18,8 +18,8 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Position, Velocity};
-use crate::schedule::{CircleSystems, run_circle_step};
+use crate::base::components::{Position, Velocity};
+use crate::step::schedule::{CircleSystems, run_circle_step};
 
 /// How a circle's `Transform` follows its [`Position`] between fixed steps. As a component it
 /// chooses for one circle; circles without it follow [`DefaultSmoothing`].

@@ -8,15 +8,15 @@
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::boundary::WallCollisions;
-use crate::collide::PairCollisions;
-use crate::collide::overlaps::Overlaps;
-use crate::collision_layers::{LayeredDisc, layered_disc};
-use crate::config::Solver;
-use crate::diagnostics::{CircleDiagnostics, Pressure};
-use crate::schedule::StepTotals;
-use crate::sleep::Sleeping;
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{LayeredDisc, layered_disc};
+use crate::base::config::Solver;
+use crate::base::hits::PairCollisions;
+use crate::collision::overlaps::Overlaps;
+use crate::game::diagnostics::{CircleDiagnostics, Pressure};
+use crate::step::boundary::WallCollisions;
+use crate::step::schedule::StepTotals;
+use crate::step::sleep::Sleeping;
 
 /// The HUD text and the help overlay.
 #[derive(Clone, Copy, Debug, Default)]

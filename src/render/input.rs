@@ -5,9 +5,9 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Position, Radius, Velocity};
-use crate::config::{Solver, SpawnConfig};
-use crate::spawn::Respawn;
+use crate::base::components::{Position, Radius, Velocity};
+use crate::base::config::{Solver, SpawnConfig};
+use crate::game::spawn::Respawn;
 
 /// The app's keys and mouse drag.
 #[derive(Clone, Copy, Debug, Default)]

@@ -4,7 +4,7 @@
 //! turns with the circle's [`Rotation`]), a thin bar per segment wall, and
 //! the [`hud`], [`input`] and [`screenshot`] plugins; the app adds the live [`panel`]. The
 //! simulation never reads anything from here; the core group's
-//! [`transform_sync`](crate::transform_sync) moves the sprites.
+//! [`transform_sync`](crate::game::transform_sync) moves the sprites.
 
 pub mod hud;
 pub mod input;
@@ -16,9 +16,9 @@ use bevy::camera::ScalingMode;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 
-use crate::arena::Arena;
-use crate::components::{Position, Radius, Rotation, Tint};
-use crate::segment::Segments;
+use crate::base::arena::Arena;
+use crate::base::components::{Position, Radius, Rotation, Tint};
+use crate::base::segment::Segments;
 
 /// Everything the window shows: arena, circles, HUD and the keyboard and mouse controls.
 #[derive(Clone, Copy, Debug, Default)]
@@ -174,7 +174,7 @@ fn draw_segment_walls(
 pub struct DiscSprite;
 
 /// Gives every new circle without a sprite of its own a tinted disc. Its `Transform` then
-/// follows the circle's position ([`transform_sync`](crate::transform_sync)).
+/// follows the circle's position ([`transform_sync`](crate::game::transform_sync)).
 fn attach_sprites(
     mut commands: Commands,
     disc: Option<Res<DiscTexture>>,
@@ -248,7 +248,7 @@ pub struct AppOptions {
 
 /// The complete windowed app: Bevy's default plugins (as far as the enabled features go), the
 /// simulation, drawing, HUD and controls, and hot reload of the scene file if there is one.
-pub fn app(config: crate::config::CirclesConfig, options: AppOptions) -> App {
+pub fn app(config: crate::base::config::CirclesConfig, options: AppOptions) -> App {
     use bevy::asset::io::AssetSourceBuilder;
 
     let mut app = App::new();
@@ -281,14 +281,14 @@ pub fn app(config: crate::config::CirclesConfig, options: AppOptions) -> App {
                 watch_for_changes_override: Some(watched.is_some()),
                 ..default()
             }),
-        crate::CirclesPlugins::new(config),
+        crate::game::plugins::CirclesPlugins::new(config),
         CirclesRenderPlugin,
         panel::PanelPlugin {
             open: options.panel,
         },
     ));
     if let Some(asset_path) = watched {
-        app.add_plugins(crate::scene::asset::SceneReloadPlugin { asset_path });
+        app.add_plugins(crate::tools::scene::asset::SceneReloadPlugin { asset_path });
     }
     if let Some((path, frames)) = options.screenshot {
         app.add_plugins(screenshot::ScreenshotPlugin { path, frames });

@@ -12,9 +12,9 @@ use bevy::ecs::system::ScheduleSystem;
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 
-use crate::arena::{Arena, Boundary};
-use crate::config::Effects;
-use crate::segment::Segments;
+use crate::base::arena::{Arena, Boundary};
+use crate::base::config::Effects;
+use crate::base::segment::Segments;
 
 /// One schedulable effect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -162,7 +162,7 @@ pub fn register_effect(
 
 /// Makes the schedules hold exactly the systems of the registered effects that the world's
 /// [`Effects`], [`Arena`] and [`Segments`] call for: adds the missing ones and removes the rest.
-/// [`StepPlugin`](crate::schedule::StepPlugin) runs it before a fixed step whenever one of them
+/// [`StepPlugin`](crate::step::schedule::StepPlugin) runs it before a fixed step whenever one of them
 /// changed (game code, a reloaded scene, the panel): the one path by which the schedule follows.
 pub fn reconcile_effects(world: &mut World) {
     let effects = *world.resource::<Effects>();

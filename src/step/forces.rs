@@ -9,10 +9,10 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::components::{Mass, Sleep, Velocity};
-use crate::config::Effects;
-use crate::effects::{Effect, EffectSystems, register_effect};
-use crate::schedule::{CircleStep, CircleSystems, ContinuousStep, StepDt};
+use crate::base::components::{Mass, Sleep, Velocity};
+use crate::base::config::Effects;
+use crate::step::effects::{Effect, EffectSystems, register_effect};
+use crate::step::schedule::{CircleStep, CircleSystems, ContinuousStep, StepDt};
 
 /// Constant acceleration `effects.gravity`.
 #[derive(Clone, Copy, Debug, Default)]

@@ -3,8 +3,8 @@
 
 use bevy::prelude::*;
 
-use crate::components::{AngularVelocity, Position, Rotation, Sleep, SpinCircles, Velocity};
-use crate::schedule::{CircleStep, CircleSystems, StepDt};
+use crate::base::components::{AngularVelocity, Position, Rotation, Sleep, SpinCircles, Velocity};
+use crate::step::schedule::{CircleStep, CircleSystems, StepDt};
 
 /// Moves every circle along its velocity for one (sub)step.
 #[derive(Clone, Copy, Debug, Default)]
@@ -16,7 +16,7 @@ impl Plugin for IntegratePlugin {
             .register_type::<Velocity>()
             .register_type::<Rotation>()
             .register_type::<AngularVelocity>()
-            .register_type::<crate::components::Inertia>()
+            .register_type::<crate::base::components::Inertia>()
             .add_systems(
                 CircleStep,
                 integrate_positions.in_set(CircleSystems::Integrate),

@@ -18,10 +18,10 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::config::{Effects, SoftConfig, Solver};
-use crate::effects::reconcile_effects;
-use crate::segment::Segments;
+use crate::base::arena::Arena;
+use crate::base::config::{Effects, SoftConfig, Solver};
+use crate::base::segment::Segments;
+use crate::step::effects::reconcile_effects;
 
 /// The system sets of the simulation, in the order they run.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -109,7 +109,7 @@ impl StepTotals {
 /// and a spawning it stops spawns no more batches ([`SpawnReport::interrupted`]).
 /// Absent, or never set, nothing changes.
 ///
-/// [`SpawnReport::interrupted`]: crate::spawn::SpawnReport::interrupted
+/// [`SpawnReport::interrupted`]: crate::game::spawn::SpawnReport::interrupted
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StopRequest(pub std::sync::Arc<std::sync::atomic::AtomicBool>);
 

@@ -3,7 +3,7 @@
 //! its pending events, and what code gave circles of their own — so that `run --resume` goes
 //! on bit for bit as the run would have (a game whose circles gained components goes on from
 //! the same state, its circles perhaps in another query order: see `own`).
-//! Written by `run --checkpoint` through [`write_atomically`](crate::io::write_atomically) in
+//! Written by `run --checkpoint` through [`write_atomically`](crate::base::io::write_atomically) in
 //! a compact binary form (postcard) that ends in a checksum (`bytes`); read back with a size
 //! limit, the checksum and every value checked, so a damaged or forged file is an error naming
 //! the file, never a panic.
@@ -11,26 +11,26 @@
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::arena::Arena;
-use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, snapshot_with_entities};
-use crate::collide::PairCollisions;
-use crate::components::Sleep;
-use crate::config::{
+use crate::base::arena::Arena;
+use crate::base::circle::{CircleState, snapshot_with_entities};
+use crate::base::components::Sleep;
+use crate::base::config::{
     CirclesConfig, DropConfig, Effects, MAX_CIRCLES, MassModel, SoftConfig, Solver, SpawnConfig,
     min_radius,
 };
-use crate::error::InputError;
-use crate::exact::EngineState;
-use crate::exact::engine::EngineSnapshot;
-use crate::range::check_mass;
-use crate::run::{Progress, headless_app};
-use crate::scene::check::check_motion;
-use crate::schedule::StepTotals;
-use crate::segment::Segments;
-use crate::sleep::Sleeping;
-use crate::soft::{CacheSnapshot, SoftState};
-use crate::spawn::{Dropped, SpawnReport};
+use crate::base::error::InputError;
+use crate::base::hits::PairCollisions;
+use crate::base::range::check_mass;
+use crate::base::segment::Segments;
+use crate::game::spawn::{Dropped, SpawnReport};
+use crate::solvers::exact::EngineState;
+use crate::solvers::exact::engine::EngineSnapshot;
+use crate::solvers::soft::{CacheSnapshot, SoftState};
+use crate::step::boundary::WallCollisions;
+use crate::step::schedule::StepTotals;
+use crate::step::sleep::Sleeping;
+use crate::tools::run::{Progress, headless_app};
+use crate::tools::scene::check::check_motion;
 use bytes::FORMAT;
 use own::OwnParts;
 
@@ -176,7 +176,8 @@ impl Checkpoint {
     /// as a scene's; circles within the physical range). Says what is wrong. What the reader
     /// applies, and what `moving_circles run` applies before it writes one.
     pub(crate) fn check(&self) -> Result<(), String> {
-        let describe = |e: crate::error::FieldError| format!("field `{}`: {}", e.field, e.message);
+        let describe =
+            |e: crate::base::error::FieldError| format!("field `{}`: {}", e.field, e.message);
         self.config().check().map_err(describe)?;
         if self.circles.len() > MAX_CIRCLES {
             return Err(format!(

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
 /// The typeface for all text (DejaVu Sans; its licence is beside it in `assets/fonts`).
-const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// A picture that can be drawn on any plotters backend.
 pub trait Figure {

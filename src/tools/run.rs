@@ -11,22 +11,22 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::{Deserialize, Serialize};
 
-use crate::CirclesPlugins;
-use crate::arena::Arena;
-use crate::boundary::WallCollisions;
-use crate::circle::{CircleState, Parts, from_components, inertia, snapshot};
-use crate::collide::PairCollisions;
-use crate::collide::overlaps::Overlaps;
-use crate::collision_layers::{LayeredDisc, layered_disc};
-use crate::components::{Inertia, Sleep};
-use crate::config::{CirclesConfig, Effects, Solver};
-use crate::diagnostics::{Measuring, Pressure, Totals, dropped_totals, relative_change};
-use crate::effects::{Effect, EffectRegistry};
-use crate::error::FieldError;
-use crate::exact::EngineState;
-use crate::scene::check::check_motion;
-use crate::schedule::StepTotals;
-use crate::spawn::{Dropped, SpawnReport};
+use crate::base::arena::Arena;
+use crate::base::circle::{CircleState, Parts, from_components, inertia, snapshot};
+use crate::base::collision_layers::{LayeredDisc, layered_disc};
+use crate::base::components::{Inertia, Sleep};
+use crate::base::config::{CirclesConfig, Effects, Solver};
+use crate::base::error::FieldError;
+use crate::base::hits::PairCollisions;
+use crate::collision::overlaps::Overlaps;
+use crate::game::diagnostics::{Measuring, Pressure, Totals, dropped_totals, relative_change};
+use crate::game::plugins::CirclesPlugins;
+use crate::game::spawn::{Dropped, SpawnReport};
+use crate::solvers::exact::EngineState;
+use crate::step::boundary::WallCollisions;
+use crate::step::effects::{Effect, EffectRegistry};
+use crate::step::schedule::StepTotals;
+use crate::tools::scene::check::check_motion;
 
 /// A headless app for `config`, past `Startup` (circles spawned), in which every `update()`
 /// advances exactly one fixed step.
@@ -38,7 +38,7 @@ use crate::spawn::{Dropped, SpawnReport};
 ///
 /// ```
 /// use moving_circles::prelude::*;
-/// use moving_circles::run::headless_app;
+/// use moving_circles::tools::run::headless_app;
 ///
 /// let mut app = headless_app(CirclesConfig::default());
 /// app.update();
@@ -146,7 +146,7 @@ impl Progress {
 
 /// Steps `app` until its [`StepTotals`] reach `until`, or until `stop` says so after a step,
 /// timing the steps alone into `progress`. While it steps, the app's
-/// [`CircleDiagnostics`](crate::diagnostics::CircleDiagnostics) are not measured
+/// [`CircleDiagnostics`](crate::game::diagnostics::CircleDiagnostics) are not measured
 /// ([`Measuring::AfterSpawn`]; the run takes its own totals), so they are stale until the app's
 /// next step after this. After every step whose number is a multiple of `sample_every` it
 /// measures the overlaps into `progress` and hands a [`Sample`] to `observe`. Step numbers count from the start of the run, so a run resumed from a

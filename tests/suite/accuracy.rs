@@ -6,11 +6,11 @@
 use std::process::Command;
 
 use bevy::math::DVec2;
-use moving_circles::accuracy::auto::choose_solver;
-use moving_circles::accuracy::front::MEASURES;
-use moving_circles::accuracy::passed_through;
-use moving_circles::accuracy::plot::FIGURE_SIZE;
 use moving_circles::prelude::*;
+use moving_circles::tools::accuracy::auto::choose_solver;
+use moving_circles::tools::accuracy::front::MEASURES;
+use moving_circles::tools::accuracy::passed_through;
+use moving_circles::tools::accuracy::plot::FIGURE_SIZE;
 
 fn circle(x: f64, vx: f64) -> CircleState {
     CircleState::new(DVec2::new(x, 0.0), DVec2::new(vx, 0.0), 0.1)

@@ -5,15 +5,15 @@
 
 use crate::common::*;
 use bevy::prelude::*;
-use moving_circles::diagnostics::Pressure;
+use moving_circles::game::diagnostics::Pressure;
 use moving_circles::prelude::*;
 use moving_circles::render::hud::{HelpVisible, HudPlugin, HudRates, HudText};
 use moving_circles::render::input::InputPlugin;
-use moving_circles::run::headless_app_with;
+use moving_circles::tools::run::headless_app_with;
 
 /// The classic scene with the app's input and HUD plugins, past its first update.
 fn app() -> App {
-    headless_app_with(moving_circles::scene::classic(), |app| {
+    headless_app_with(moving_circles::tools::scene::classic(), |app| {
         app.init_resource::<ButtonInput<KeyCode>>()
             .init_resource::<ButtonInput<MouseButton>>()
             .add_plugins((InputPlugin, HudPlugin));
@@ -50,7 +50,7 @@ fn r_respawns_from_the_same_seed() {
     app.update(); // the respawn runs in the next frame's PreUpdate
     assert_eq!(generation(&app), spawned + 1, "one respawn");
     assert_eq!(steps(&app), 1, "counters restart at the respawn");
-    let mut fresh = headless_app_with(moving_circles::scene::classic(), |_| {});
+    let mut fresh = headless_app_with(moving_circles::tools::scene::classic(), |_| {});
     fresh.update();
     assert_eq!(
         circles(&mut app),

@@ -6,10 +6,10 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::circle::snapshot_with_entities;
-use moving_circles::collide::overlaps::overlapping_circles;
-use moving_circles::exact::EngineState;
+use moving_circles::base::circle::snapshot_with_entities;
+use moving_circles::collision::overlaps::overlapping_circles;
 use moving_circles::prelude::*;
+use moving_circles::solvers::exact::EngineState;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

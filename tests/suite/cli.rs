@@ -75,9 +75,11 @@ fn run_writes_every_report_field_and_dumps_the_final_state() {
         "{json}"
     );
 
-    let final_state =
-        moving_circles::scene::particles::read(&dump, moving_circles::prelude::Boundary::Walls)
-            .expect("the dump is a valid particle file");
+    let final_state = moving_circles::tools::scene::particles::read(
+        &dump,
+        moving_circles::prelude::Boundary::Walls,
+    )
+    .expect("the dump is a valid particle file");
     assert_eq!(final_state.len(), 16);
     std::fs::remove_dir_all(&dir).unwrap();
 }

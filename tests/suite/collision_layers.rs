@@ -6,10 +6,10 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::arena::{Arena, Boundary};
-use moving_circles::circle::CircleState;
-use moving_circles::exact::engine::EventEngine;
+use moving_circles::base::arena::{Arena, Boundary};
+use moving_circles::base::circle::CircleState;
 use moving_circles::prelude::*;
+use moving_circles::solvers::exact::engine::EventEngine;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

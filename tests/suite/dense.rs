@@ -6,10 +6,10 @@ use std::process::Command;
 
 use crate::common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use bevy::math::DVec2;
-use moving_circles::circle::{discs, snapshot};
-use moving_circles::collide::overlaps::Overlaps;
+use moving_circles::base::circle::{discs, snapshot};
+use moving_circles::collision::overlaps::Overlaps;
+use moving_circles::game::spawn::place_circles;
 use moving_circles::prelude::*;
-use moving_circles::spawn::place_circles;
 
 /// A unit box asked for `fraction` of circles of radius `r` on a lattice.
 fn lattice_config(fraction: f64, r: f64, boundary: Boundary) -> CirclesConfig {

@@ -4,8 +4,8 @@
 
 use std::process::Command;
 
-use moving_circles::eos::theory::ks_critical_5_percent;
-use moving_circles::eos::{EosOptions, measure};
+use moving_circles::tools::eos::theory::ks_critical_5_percent;
+use moving_circles::tools::eos::{EosOptions, measure};
 
 fn small(area_fractions: Vec<f64>) -> EosOptions {
     EosOptions {

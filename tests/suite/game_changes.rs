@@ -7,8 +7,8 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::effects::EffectRegistry;
 use moving_circles::prelude::*;
+use moving_circles::step::effects::EffectRegistry;
 
 /// What the game's system does, and in which frame.
 #[derive(Resource)]

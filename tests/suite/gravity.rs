@@ -54,7 +54,9 @@ fn an_elastic_gas_under_gravity_keeps_its_energy_to_rounding_over_ten_thousand_c
                 drift <= 1e-12,
                 "{solver}, g = {g}: energy drifted by {drift:e}"
             );
-            let budget = app.world().resource::<moving_circles::exact::EngineState>();
+            let budget = app
+                .world()
+                .resource::<moving_circles::solvers::exact::EngineState>();
             assert_eq!(budget.budget_exhausted, 0);
             assert_eq!(
                 app.world().resource::<Sleeping>().count,
@@ -96,7 +98,9 @@ fn at_any_gravity_in_any_direction_an_elastic_gas_keeps_its_energy_and_nothing_m
                 let what = format!("{solver}, g = {g}: {} hits in {steps} steps", hits(&app));
                 assert!(hits(&app) >= 2_000, "{what}");
                 assert!(drift <= 1e-12, "{what}: energy drifted by {drift:e}");
-                let engine = app.world().resource::<moving_circles::exact::EngineState>();
+                let engine = app
+                    .world()
+                    .resource::<moving_circles::solvers::exact::EngineState>();
                 assert_eq!(engine.budget_exhausted, 0, "{what}");
                 assert_eq!(
                     app.world().resource::<Sleeping>().count,

@@ -27,11 +27,11 @@ use std::path::Path;
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::circle::{CircleState, discs, snapshot};
-use moving_circles::collide::overlaps::overlapping_circles;
+use moving_circles::base::circle::{CircleState, discs, snapshot};
+use moving_circles::collision::overlaps::overlapping_circles;
 use moving_circles::prelude::*;
-use moving_circles::run::run_steps;
-use moving_circles::scene::particles;
+use moving_circles::tools::run::run_steps;
+use moving_circles::tools::scene::particles;
 
 /// Overlap (in smaller radii) that is rounding, not penetration.
 const ROUNDING: f64 = 1e-9;

@@ -8,7 +8,7 @@ use std::os::unix::fs::FileTypeExt;
 use std::process::{Command, Output};
 
 use crate::common::binary::{assert_refused, moving_circles, under_one_gib};
-use moving_circles::config::MAX_CIRCLES;
+use moving_circles::base::config::MAX_CIRCLES;
 
 /// `run` on two steps of the classic scene, with `extra` flags.
 fn run_classic(extra: &[&str]) -> Output {

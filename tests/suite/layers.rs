@@ -1,6 +1,7 @@
-//! The structure rules of `src/`, checked on the source text: no two files import each other
-//! through any chain (every import points from a higher layer to a lower one), and no file is
-//! over 450 lines.
+//! The structure rules of `src/`, checked on the source text: every import points down the
+//! layers (`base`, `collision`, `step`, `solvers`, `game`, `tools`, `render`, `cli`, and
+//! `lib.rs`, which declares them) or stays within its layer, no solver's folder imports another's, no two
+//! files import each other through any chain, and no file is over 450 lines.
 //!
 //! An import is any `crate::…` or `super::…` path in code (comments are skipped), including
 //! each branch of a `use` tree; it points at the deepest module file the path names.
@@ -22,7 +23,7 @@ fn rust_files(dir: &Path) -> Vec<PathBuf> {
     files
 }
 
-/// The module path of a file: `src/collide/mod.rs` is `["collide"]`, `src/lib.rs` is `[]`.
+/// The module path of a file: `src/solvers/discrete/mod.rs` is `["solvers", "discrete"]`, `src/lib.rs` is `[]`.
 fn module_of(src: &Path, file: &Path) -> Vec<String> {
     let rel = file.strip_prefix(src).unwrap().with_extension("");
     let mut parts: Vec<String> = rel
@@ -229,11 +230,14 @@ fn no_file_imports_itself_through_other_files() {
     // among them these.
     assert!(edges > 100, "only {edges} imports found");
     for (from, to) in [
-        ("collide/pass.rs", "collide/contact.rs"),
-        ("exact/engine/predict.rs", "exact/engine/mod.rs"),
-        ("exact/engine/predict.rs", "exact/toi.rs"),
-        ("scene/check.rs", "scene/schema.rs"),
-        ("run.rs", "lib.rs"),
+        ("solvers/discrete/pass.rs", "collision/contact.rs"),
+        (
+            "solvers/exact/engine/predict.rs",
+            "solvers/exact/engine/mod.rs",
+        ),
+        ("solvers/exact/engine/predict.rs", "collision/toi.rs"),
+        ("tools/scene/check.rs", "tools/scene/schema.rs"),
+        ("tools/run.rs", "game/plugins.rs"),
     ] {
         assert!(
             graph[&src().join(from)].contains(&src().join(to)),
@@ -248,6 +252,99 @@ fn no_file_imports_itself_through_other_files() {
             .collect();
         panic!("import cycle: {}", names.join(" → "));
     }
+}
+
+/// The layers of `src/`, bottom first: a file may import its own layer and those below.
+const LAYERS: [&str; 9] = [
+    "base",
+    "collision",
+    "step",
+    "solvers",
+    "game",
+    "tools",
+    "render",
+    "cli",
+    "lib.rs",
+];
+
+/// The layer of a file (its top folder under `src/`, or `lib.rs`) and, for a solver, its folder.
+fn place_of(file: &Path) -> (usize, Option<String>) {
+    let parts: Vec<String> = file
+        .strip_prefix(src())
+        .unwrap()
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let layer = LAYERS
+        .iter()
+        .position(|l| *l == parts[0])
+        .unwrap_or_else(|| panic!("{} is in no layer of {LAYERS:?}", file.display()));
+    let solver = (parts[0] == "solvers" && parts.len() > 2).then(|| parts[1].clone());
+    (layer, solver)
+}
+
+/// Every import that points up the layers or from one solver's folder into another's.
+fn imports_against_the_layers(graph: &BTreeMap<PathBuf, BTreeSet<PathBuf>>) -> Vec<String> {
+    let mut wrong = Vec::new();
+    for (from, targets) in graph {
+        let (layer, solver) = place_of(from);
+        for to in targets {
+            let (to_layer, to_solver) = place_of(to);
+            let sideways = solver.is_some() && to_solver.is_some() && solver != to_solver;
+            if to_layer > layer || sideways {
+                wrong.push(format!(
+                    "{} -> {}",
+                    from.strip_prefix(src()).unwrap().display(),
+                    to.strip_prefix(src()).unwrap().display()
+                ));
+            }
+        }
+    }
+    wrong
+}
+
+#[test]
+fn every_import_points_down_the_layers_and_no_solver_imports_another() {
+    let src = src();
+    let tops: BTreeSet<String> = std::fs::read_dir(&src)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    let expected: BTreeSet<String> = LAYERS
+        .iter()
+        .map(|l| l.to_string())
+        .chain(["main.rs".to_owned()])
+        .collect();
+    assert_eq!(tops, expected, "src/ holds the layers and the binary alone");
+    let graph = import_graph(&src);
+    let wrong = imports_against_the_layers(&graph);
+    assert!(wrong.is_empty(), "imports against the layers: {wrong:#?}");
+}
+
+#[test]
+fn an_import_up_the_layers_or_between_solvers_is_found() {
+    let file = |p: &str| src().join(p);
+    let graph = BTreeMap::from([
+        (
+            file("collision/toi.rs"),
+            BTreeSet::from([file("base/segment.rs"), file("step/schedule.rs")]),
+        ),
+        (
+            file("solvers/soft/solve.rs"),
+            BTreeSet::from([file("solvers/soft/rules.rs"), file("solvers/exact/keep.rs")]),
+        ),
+        (
+            file("tools/run.rs"),
+            BTreeSet::from([file("game/plugins.rs")]),
+        ),
+    ]);
+    assert_eq!(
+        imports_against_the_layers(&graph),
+        [
+            "collision/toi.rs -> step/schedule.rs",
+            "solvers/soft/solve.rs -> solvers/exact/keep.rs"
+        ]
+    );
 }
 
 #[test]

@@ -4,7 +4,7 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use moving_circles::prelude::*;
-use moving_circles::schedule::StepDt;
+use moving_circles::step::schedule::StepDt;
 
 #[test]
 fn a_lone_circle_moves_exactly_v_dt_per_step() {

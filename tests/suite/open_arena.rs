@@ -5,10 +5,10 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::checkpoint::Checkpoint;
-use moving_circles::effects::EffectRegistry;
 use moving_circles::prelude::*;
-use moving_circles::run::Progress;
+use moving_circles::step::effects::EffectRegistry;
+use moving_circles::tools::checkpoint::Checkpoint;
+use moving_circles::tools::run::Progress;
 
 fn open(solver: Solver, gravity: Option<DVec2>, segments: Vec<Segment>) -> CirclesConfig {
     CirclesConfig {

@@ -10,16 +10,16 @@ use std::time::{Duration, Instant};
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::accuracy::SOLVERS;
 use moving_circles::prelude::*;
 use moving_circles::render::panel::{
     Comparison, Control, LiveHistory, PanelOpen, PanelStatePlugin,
 };
-use moving_circles::run::headless_app_with;
+use moving_circles::tools::accuracy::SOLVERS;
+use moving_circles::tools::run::headless_app_with;
 
 /// The classic scene with the panel's state plugin, shown or not.
 fn app(open: bool) -> App {
-    headless_app_with(moving_circles::scene::classic(), |app| {
+    headless_app_with(moving_circles::tools::scene::classic(), |app| {
         app.init_resource::<ButtonInput<KeyCode>>()
             .add_plugins(PanelStatePlugin { open });
     })

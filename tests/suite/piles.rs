@@ -10,8 +10,8 @@ use std::path::Path;
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::circle::{CircleState, discs, snapshot};
-use moving_circles::collide::overlaps::Overlaps;
+use moving_circles::base::circle::{CircleState, discs, snapshot};
+use moving_circles::collision::overlaps::Overlaps;
 use moving_circles::prelude::*;
 
 fn scene(name: &str, solver: &str) -> App {
@@ -149,7 +149,7 @@ fn the_column_and_the_pyramid_stand_exactly_and_sleep_under_the_event_driven_sol
 /// Runs the scene `text` (named `name`) for 10 s and checks what the event-driven solvers
 /// promise a pile: asleep, no overlap beyond rounding after any step, nothing escaped or
 /// non-finite, the event budget never out. Returns the run's report.
-fn drops_and_sleeps(text: &str, name: &str) -> moving_circles::run::Report {
+fn drops_and_sleeps(text: &str, name: &str) -> moving_circles::tools::run::Report {
     let mut app = written(text, name);
     let mut deepest = 0.0f64;
     for _ in 0..10 * 60 {
@@ -157,10 +157,10 @@ fn drops_and_sleeps(text: &str, name: &str) -> moving_circles::run::Report {
         deepest = deepest.max(overlap(&mut app).max);
     }
     let (asleep, _) = settled(&mut app);
-    let report = moving_circles::run::Report::new(
+    let report = moving_circles::tools::run::Report::new(
         app.world_mut(),
         name,
-        &moving_circles::run::Progress::default(),
+        &moving_circles::tools::run::Progress::default(),
     );
     eprintln!(
         "{text}: deepest {deepest:e}, asleep {asleep}, pair collisions {}",
@@ -192,7 +192,7 @@ fn a_heap_falls_settles_and_sleeps_with_no_overlap_under_the_event_driven_solver
 
 #[test]
 fn a_heap_asleep_under_swept_builds_no_engine_until_something_moves() {
-    use moving_circles::exact::EngineState;
+    use moving_circles::solvers::exact::EngineState;
     let mut app = written(&heap("swept"), "heap.ron");
     step(&mut app, 10 * 60);
     assert!(settled(&mut app).0, "not asleep after 10 s");

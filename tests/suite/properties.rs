@@ -4,13 +4,13 @@
 
 use crate::common::unit_box_gas;
 use bevy::math::DVec2;
-use moving_circles::arena::Arena;
-use moving_circles::boundary::reflect_off_walls;
-use moving_circles::circle::{CircleState, disc_inverse_inertia};
-use moving_circles::collide::contact::resolve_contact;
-use moving_circles::exact::engine::EventEngine;
-use moving_circles::exact::rough::{RoughSide, apply_rough_impulse};
-use moving_circles::exact::toi::pair_time_of_impact;
+use moving_circles::base::arena::Arena;
+use moving_circles::base::circle::{CircleState, disc_inverse_inertia};
+use moving_circles::collision::contact::resolve_contact;
+use moving_circles::collision::rough::{RoughSide, apply_rough_impulse};
+use moving_circles::collision::toi::pair_time_of_impact;
+use moving_circles::solvers::exact::engine::EventEngine;
+use moving_circles::step::boundary::reflect_off_walls;
 use proptest::prelude::*;
 
 /// A number with a random sign and a magnitude from 1e-6 to 1e6.

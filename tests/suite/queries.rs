@@ -5,10 +5,10 @@
 use bevy::ecs::system::RunSystemOnce;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::arena::{Arena, Boundary};
+use moving_circles::base::arena::{Arena, Boundary};
+use moving_circles::game::query::index::CircleIndex;
+use moving_circles::game::query::shapes::{ray_capsule, ray_disc};
 use moving_circles::prelude::*;
-use moving_circles::query::index::CircleIndex;
-use moving_circles::query::shapes::{ray_capsule, ray_disc};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -125,7 +125,7 @@ fn a_checkpoint_that_is_damaged_or_not_one_is_refused_by_name() {
     let header = 1 + usize::from(good[0]);
     let mut largest = good.clone();
     largest[header..].fill(0xff);
-    moving_circles::checkpoint::Checkpoint::reseal(&mut largest);
+    moving_circles::tools::checkpoint::Checkpoint::reseal(&mut largest);
     // A bit flipped deep in a number, or a byte added, could still read as a usable state:
     // the checksum refuses both.
     let cases: [(&[u8], &str); 6] = [
@@ -158,10 +158,10 @@ fn a_checkpoint_that_is_damaged_or_not_one_is_refused_by_name() {
 
 #[test]
 fn a_resumed_exact_run_goes_on_with_the_engine_it_kept() {
-    use moving_circles::checkpoint::Checkpoint;
-    use moving_circles::exact::EngineState;
     use moving_circles::prelude::*;
-    use moving_circles::run::Progress;
+    use moving_circles::solvers::exact::EngineState;
+    use moving_circles::tools::checkpoint::Checkpoint;
+    use moving_circles::tools::run::Progress;
 
     // Plain circles, and circles of which some have their own restitution: the restored engine
     // has them too, so the first step finds every circle as the engine has it. (Circles that
@@ -213,10 +213,10 @@ fn a_resumed_exact_run_goes_on_with_the_engine_it_kept() {
 struct Heard(Vec<(u64, String)>);
 
 fn listen(
-    totals: bevy::prelude::Res<moving_circles::schedule::StepTotals>,
+    totals: bevy::prelude::Res<moving_circles::step::schedule::StepTotals>,
     mut heard: bevy::prelude::ResMut<Heard>,
-    mut circle_hits: bevy::prelude::MessageReader<moving_circles::hits::CircleHit>,
-    mut wall_hits: bevy::prelude::MessageReader<moving_circles::hits::WallHit>,
+    mut circle_hits: bevy::prelude::MessageReader<moving_circles::base::hits::CircleHit>,
+    mut wall_hits: bevy::prelude::MessageReader<moving_circles::base::hits::WallHit>,
     circles: bevy::prelude::Query<
         bevy::prelude::Entity,
         bevy::prelude::With<moving_circles::prelude::Radius>,
@@ -250,7 +250,7 @@ fn listen(
 /// What code gave each circle of its own, with where the circle is, in a fixed order (the
 /// order of a query depends on the components circles were given, and when).
 fn own_parts(world: &mut bevy::prelude::World) -> Vec<String> {
-    use moving_circles::collision_layers::{Sensor, SensorOverlaps};
+    use moving_circles::base::collision_layers::{Sensor, SensorOverlaps};
     use moving_circles::prelude::*;
     let mut circles = world.query::<(
         &Position,
@@ -292,13 +292,13 @@ fn placed_parts(world: &mut bevy::prelude::World) -> Vec<(bevy::math::DVec2, Str
 /// A headless app of `config` under `solver` whose circles code changed before the first step:
 /// `made` is given each (its place in spawn order, the circle).
 fn made_app(
-    config: &moving_circles::config::CirclesConfig,
-    solver: moving_circles::config::Solver,
+    config: &moving_circles::base::config::CirclesConfig,
+    solver: moving_circles::base::config::Solver,
     made: &impl Fn(usize, &mut bevy::ecs::world::EntityWorldMut),
 ) -> bevy::prelude::App {
     use bevy::prelude::*;
     use moving_circles::prelude::*;
-    let mut app = moving_circles::run::headless_app(CirclesConfig {
+    let mut app = moving_circles::tools::run::headless_app(CirclesConfig {
         solver,
         ..config.clone()
     });
@@ -318,10 +318,10 @@ fn made_app(
 /// asserts both end in the same state and that a reader hears the same hits after the pause.
 fn resumes_bit_for_bit(scene: &str, made: impl Fn(usize, &mut bevy::ecs::world::EntityWorldMut)) {
     use bevy::prelude::*;
-    use moving_circles::checkpoint::Checkpoint;
-    use moving_circles::circle::snapshot;
+    use moving_circles::base::circle::snapshot;
     use moving_circles::prelude::*;
-    use moving_circles::run::Progress;
+    use moving_circles::tools::checkpoint::Checkpoint;
+    use moving_circles::tools::run::Progress;
     let config = Scene::parse(scene, "k.ron")
         .and_then(|s| s.to_config("k.ron"))
         .unwrap();
@@ -395,10 +395,10 @@ fn circles_of_their_own_restitution_resume_bit_for_bit_under_every_solver() {
 
 #[test]
 fn what_code_gave_circles_of_their_own_is_kept_by_a_checkpoint_under_every_solver() {
-    use moving_circles::checkpoint::Checkpoint;
-    use moving_circles::collision_layers::Sensor;
+    use moving_circles::base::collision_layers::Sensor;
     use moving_circles::prelude::*;
-    use moving_circles::run::Progress;
+    use moving_circles::tools::checkpoint::Checkpoint;
+    use moving_circles::tools::run::Progress;
     // Rough hits with friction in a box under gravity: circles of their own restitution,
     // friction and moment of inertia, a team in layers of its own, and a sensor. The resumed
     // circles are where they were with the same parts (a sensor with as many overlaps), and

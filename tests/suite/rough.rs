@@ -10,10 +10,10 @@ use std::f64::consts::PI;
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::circle::{CircleState, disc_inertia};
-use moving_circles::exact::EngineState;
-use moving_circles::exact::engine::{EventEngine, Roughness};
+use moving_circles::base::circle::{CircleState, disc_inertia};
 use moving_circles::prelude::*;
+use moving_circles::solvers::exact::EngineState;
+use moving_circles::solvers::exact::engine::{EventEngine, Roughness};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -7,7 +7,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::prelude::*;
-use moving_circles::scene::{asset::apply_config, particles};
+use moving_circles::tools::scene::{asset::apply_config, particles};
 
 fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -45,7 +45,7 @@ fn every_example_scene_loads_and_runs_clean() {
 #[test]
 fn the_app_default_is_the_classic_scene_file() {
     let from_file = Scene::load(&scene_path("classic")).unwrap();
-    assert_eq!(moving_circles::scene::classic(), from_file);
+    assert_eq!(moving_circles::tools::scene::classic(), from_file);
     assert_eq!(from_file.spawn.count, 32);
     assert_eq!(from_file.spawn.mass, MassModel::Equal(1.0));
     assert_eq!(from_file.arena.size(), DVec2::new(16.0, 9.0));

@@ -6,7 +6,7 @@ use bevy::app::PluginGroup;
 use bevy::ecs::schedule::{LogLevel, ScheduleBuildSettings};
 use bevy::prelude::*;
 use moving_circles::prelude::*;
-use moving_circles::schedule::scheduled_systems;
+use moving_circles::step::schedule::scheduled_systems;
 
 fn system_names(app: &mut App) -> Vec<String> {
     scheduled_systems(app).into_iter().map(|(_, s)| s).collect()
@@ -46,7 +46,7 @@ fn the_schedule_has_no_ambiguities() {
 
 #[test]
 fn the_default_schedule_runs_the_four_systems_of_the_seed_in_order() {
-    let mut app = create_app(moving_circles::scene::classic());
+    let mut app = create_app(moving_circles::tools::scene::classic());
     let step: Vec<_> = scheduled_systems(&mut app)
         .into_iter()
         .filter(|(schedule, _)| schedule == "CircleStep")
@@ -55,12 +55,14 @@ fn the_default_schedule_runs_the_four_systems_of_the_seed_in_order() {
     assert_eq!(
         step,
         [
-            "moving_circles::integrate::integrate_positions",
-            "moving_circles::boundary::bounce_off_walls",
-            "moving_circles::collide::collide_circles",
+            "moving_circles::step::integrate::integrate_positions",
+            "moving_circles::step::boundary::bounce_off_walls",
+            "moving_circles::solvers::discrete::collide_circles",
         ]
     );
-    assert!(system_names(&mut app).contains(&"moving_circles::spawn::spawn_circles".to_owned()));
+    assert!(
+        system_names(&mut app).contains(&"moving_circles::game::spawn::spawn_circles".to_owned())
+    );
 }
 
 #[test]
@@ -133,8 +135,8 @@ fn a_part_can_be_disabled_like_any_bevy_plugin_group() {
 
 #[test]
 fn diagnostics_are_measured_every_step_except_while_a_headless_run_steps() {
-    use moving_circles::run::run_steps;
-    let mut app = moving_circles::run::headless_app(CirclesConfig {
+    use moving_circles::tools::run::run_steps;
+    let mut app = moving_circles::tools::run::headless_app(CirclesConfig {
         solver: Solver::Exact,
         ..default()
     });

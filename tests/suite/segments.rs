@@ -6,8 +6,8 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::exact::EngineState;
 use moving_circles::prelude::*;
+use moving_circles::solvers::exact::EngineState;
 
 /// Every wall hit a game would hear.
 #[derive(Resource, Default)]

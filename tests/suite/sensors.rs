@@ -9,10 +9,10 @@ use crate::collision_layers::{
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::arena::Arena;
-use moving_circles::checkpoint::Checkpoint;
+use moving_circles::base::arena::Arena;
 use moving_circles::prelude::*;
-use moving_circles::run::Progress;
+use moving_circles::tools::checkpoint::Checkpoint;
+use moving_circles::tools::run::Progress;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -7,7 +7,7 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::circle::{CircleState, snapshot, snapshot_with_entities};
+use moving_circles::base::circle::{CircleState, snapshot, snapshot_with_entities};
 use moving_circles::prelude::*;
 
 /// The time-stepped solvers that hold a heap at rest. `discrete`'s single contact pass does
@@ -214,7 +214,7 @@ fn nothing_sleeps_without_gravity_and_sleeping_can_be_switched_off() {
     assert!(asleep(&mut app).iter().all(|&s| !s));
     let registry = app
         .world()
-        .resource::<moving_circles::effects::EffectRegistry>();
+        .resource::<moving_circles::step::effects::EffectRegistry>();
     assert!(!registry.is_scheduled(Effect::Sleep));
     // The heap with sleeping off: never asleep.
     let mut app = heap("soft");
@@ -224,9 +224,9 @@ fn nothing_sleeps_without_gravity_and_sleeping_can_be_switched_off() {
 
 #[test]
 fn a_checkpoint_marking_a_circle_asleep_resumes_under_exact_without_gravity_to_a_readable_one() {
-    use moving_circles::checkpoint::Checkpoint;
-    use moving_circles::components::Sleep;
-    use moving_circles::run::Progress;
+    use moving_circles::base::components::Sleep;
+    use moving_circles::tools::checkpoint::Checkpoint;
+    use moving_circles::tools::run::Progress;
     // A circle at rest marked asleep in a checkpoint of an `exact` run without gravity (where
     // nothing rests) and one flying at it. The engine flies it like any circle: once hit it
     // moved on still marked asleep, and the checkpoint of where the run ended was refused by

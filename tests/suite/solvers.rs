@@ -7,8 +7,8 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::exact::EngineState;
 use moving_circles::prelude::*;
+use moving_circles::solvers::exact::EngineState;
 
 fn gas_1000(solver: Solver) -> App {
     create_app(gas_1000_config(solver))
@@ -330,7 +330,7 @@ fn an_event_budget_bounds_the_work_of_a_step() {
 
 #[test]
 fn a_step_a_stop_request_ends_is_not_kept_and_the_run_goes_on_from_where_it_stopped() {
-    use moving_circles::schedule::{StepTotals, StopRequest};
+    use moving_circles::step::schedule::{StepTotals, StopRequest};
     use std::sync::Arc;
     use std::sync::atomic::{AtomicBool, Ordering};
     // `swept` hears the request while it gathers (the step moves nothing); `exact`, whose
@@ -377,7 +377,7 @@ fn a_step_a_stop_request_ends_is_not_kept_and_the_run_goes_on_from_where_it_stop
 
 #[test]
 fn a_step_whose_build_a_stop_gave_up_moves_turns_and_wakes_nothing() {
-    use moving_circles::schedule::StopRequest;
+    use moving_circles::step::schedule::StopRequest;
     use std::sync::Arc;
     use std::sync::atomic::AtomicBool;
     // Three circles at rest on the floor (asleep after the first step) and one spinning in the
@@ -426,8 +426,8 @@ fn a_step_whose_build_a_stop_gave_up_moves_turns_and_wakes_nothing() {
 
 #[test]
 fn a_stop_raised_during_the_last_step_is_reported_as_ending_the_run() {
-    use moving_circles::run::{Progress, advance};
-    use moving_circles::schedule::StepTotals;
+    use moving_circles::step::schedule::StepTotals;
+    use moving_circles::tools::run::{Progress, advance};
     use std::cell::Cell;
     // The stop comes while the run's last step runs (it may have cut it short): the run says
     // it was stopped, as the command line then reports it interrupted.

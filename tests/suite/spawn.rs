@@ -4,8 +4,8 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use moving_circles::game::spawn::place_circles;
 use moving_circles::prelude::*;
-use moving_circles::spawn::place_circles;
 
 fn assert_valid_placement(arena: &Arena, placed: &[(DVec2, f64)]) {
     for (i, &(p, r)) in placed.iter().enumerate() {
@@ -73,7 +73,7 @@ fn an_overfull_request_places_what_fits_and_reports_it() {
 #[test]
 fn the_same_seed_places_the_same_circles_and_another_seed_does_not() {
     let arena = Arena::default();
-    let spawn = moving_circles::scene::classic().spawn;
+    let spawn = moving_circles::tools::scene::classic().spawn;
     let a = place_circles(&arena, &spawn, &[], &[]).unwrap();
     let b = place_circles(&arena, &spawn, &[], &[]).unwrap();
     let c = place_circles(
@@ -122,7 +122,7 @@ fn the_same_seed_gives_the_same_state_after_600_steps() {
 
 #[test]
 fn a_respawn_replaces_every_circle() {
-    let mut app = create_app(moving_circles::scene::classic());
+    let mut app = create_app(moving_circles::tools::scene::classic());
     step(&mut app, 10);
     app.world_mut().resource_mut::<SpawnConfig>().count = 7;
     app.world_mut().write_message(Respawn);

@@ -221,7 +221,7 @@ fn circles_without_a_transform_are_left_alone() {
     assert!(world.get::<Transform>(bare).is_none());
     assert!(
         world
-            .get::<moving_circles::transform_sync::StepEnds>(bare)
+            .get::<moving_circles::game::transform_sync::StepEnds>(bare)
             .is_none()
     );
 }

@@ -5,9 +5,9 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::arena::Arena;
-use crate::error::FieldError;
-use crate::range::{check_magnitude, check_mass, check_vector};
+use crate::base::arena::Arena;
+use crate::base::error::FieldError;
+use crate::base::range::{check_magnitude, check_mass, check_vector};
 
 use super::spawn::{MIN_RADIUS_FRACTION, min_radius};
 use super::{MAX_CIRCLES, MassModel};

@@ -7,8 +7,8 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::error::FieldError;
-use crate::range::{MAX_MAGNITUDE, check_vector};
+use crate::base::error::FieldError;
+use crate::base::range::{MAX_MAGNITUDE, check_vector};
 
 /// The effects a scene calls for. Only these get systems in the schedule: no gravity, no
 /// gravity system; no collisions, no broad phase.
@@ -30,12 +30,12 @@ pub struct Effects {
     /// Coefficient of friction between circles (Coulomb's μ, 0 or more): a contact's push
     /// along its surface is at most μ times its push along the normal. 0, the default, is
     /// smooth. Friction acts under the contact solver `soft`, which then turns circles
-    /// ([`AngularVelocity`](crate::components::AngularVelocity)); the other solvers treat
+    /// ([`AngularVelocity`](crate::base::components::AngularVelocity)); the other solvers treat
     /// circles as smooth.
     pub friction: f64,
     /// Coefficient of friction against arena walls and segment walls.
     pub wall_friction: f64,
-    /// How two friction coefficients meet (a circle's own [`Friction`](crate::components::Friction)
+    /// How two friction coefficients meet (a circle's own [`Friction`](crate::base::components::Friction)
     /// and its partner's, or the walls'): their geometric mean by default.
     pub friction_combine: Combine,
     /// Rolling resistance (dimensionless, 0 or more): a rolling circle is slowed by a torque
@@ -50,8 +50,8 @@ pub struct Effects {
     pub tangential_restitution: f64,
     /// Tangential restitution β between a circle and a wall (arena or segment wall).
     pub wall_tangential_restitution: f64,
-    /// Write a [`CircleHit`](crate::hits::CircleHit) message per circle-circle impulse and a
-    /// [`WallHit`](crate::hits::WallHit) per wall hit, under every solver. Off, nothing is
+    /// Write a [`CircleHit`](crate::base::hits::CircleHit) message per circle-circle impulse and a
+    /// [`WallHit`](crate::base::hits::WallHit) per wall hit, under every solver. Off, nothing is
     /// recorded.
     pub hit_messages: bool,
     /// When circles at rest fall asleep (only under gravity: without it nothing rests).
@@ -107,7 +107,7 @@ impl Combine {
     /// The coefficient of a contact between surfaces of coefficients `a` and `b`.
     ///
     /// ```
-    /// use moving_circles::config::Combine;
+    /// use moving_circles::base::config::Combine;
     ///
     /// assert_eq!(Combine::GeometricMean.apply(0.5, 0.5), 0.5);
     /// assert_eq!(Combine::GeometricMean.apply(0.0, 0.9), 0.0);

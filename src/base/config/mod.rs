@@ -10,11 +10,11 @@ use std::str::FromStr;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::error::FieldError;
-pub use crate::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, check_vector};
-use crate::segment::Segments;
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::error::FieldError;
+pub use crate::base::range::{MAX_MAGNITUDE, MIN_MASS, check_magnitude, check_mass, check_vector};
+use crate::base::segment::Segments;
 pub use drop::DropConfig;
 pub use effects::{Combine, Effects, MAX_FRICTION, SleepConfig};
 pub use soft::SoftConfig;
@@ -45,7 +45,7 @@ pub const SOFT_SUBSTEPS: u32 = 4;
 /// as `discrete`, `substeps=N`, `soft` (or `soft=N`), `swept` or `exact`.
 ///
 /// ```
-/// use moving_circles::config::Solver;
+/// use moving_circles::base::config::Solver;
 ///
 /// let solver: Solver = "substeps=4".parse().unwrap();
 /// assert_eq!((solver, solver.substeps()), (Solver::Substeps(4), 4));
@@ -154,7 +154,7 @@ impl<'de> Deserialize<'de> for Solver {
 }
 
 /// Everything [`CirclesPlugins`](crate::CirclesPlugins) needs, in one value. Scene files
-/// ([`crate::scene`]) are read into this.
+/// ([`crate::tools::scene`]) are read into this.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CirclesConfig {
     /// The arena and its edges.
@@ -180,7 +180,7 @@ pub struct CirclesConfig {
 impl Default for CirclesConfig {
     /// Nothing spawned, in a 16:9 arena with walls, stepped at 60 Hz with the `discrete` solver:
     /// what the plugin group starts from when a game asks for nothing. The app and the command
-    /// line start from the classic scene instead ([`scene::classic`](crate::scene::classic)).
+    /// line start from the classic scene instead ([`scene::classic`](crate::tools::scene::classic)).
     fn default() -> Self {
         Self {
             arena: Arena::default(),

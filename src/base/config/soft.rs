@@ -9,8 +9,8 @@
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::error::FieldError;
-use crate::range::MAX_MAGNITUDE;
+use crate::base::error::FieldError;
+use crate::base::range::MAX_MAGNITUDE;
 
 /// How the `soft` solver's contacts behave: soft constraints (a spring of `hertz` with
 /// `damping_ratio`, twice as stiff against immovable bodies and walls), overlap pushed out at

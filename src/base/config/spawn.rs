@@ -8,10 +8,10 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::MAX_CIRCLES;
-use crate::arena::Arena;
-use crate::error::FieldError;
-use crate::lattice::lattice_fits;
-use crate::range::{check_magnitude, check_mass};
+use crate::base::arena::Arena;
+use crate::base::error::FieldError;
+use crate::base::lattice::lattice_fits;
+use crate::base::range::{check_magnitude, check_mass};
 
 /// Smallest radius, as a fraction of the arena's smaller side: below it the solvers' rounding
 /// of positions is the size of the circle, and ratios of radii overflow.

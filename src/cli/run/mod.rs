@@ -14,13 +14,13 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use anyhow::{Context, bail};
 use bevy::prelude::App;
 
-use crate::checkpoint::Checkpoint;
-use crate::circle::snapshot;
-use crate::config::Solver;
-use crate::io::{self, say};
-use crate::run::{Progress, Report, advance, default_sampling, out_of_range, sample_end};
-use crate::scene::particles;
-use crate::schedule::{StepTotals, StopRequest};
+use crate::base::circle::snapshot;
+use crate::base::config::Solver;
+use crate::base::io::{self, say};
+use crate::step::schedule::{StepTotals, StopRequest};
+use crate::tools::checkpoint::Checkpoint;
+use crate::tools::run::{Progress, Report, advance, default_sampling, out_of_range, sample_end};
+use crate::tools::scene::particles;
 pub use options::{Finished, Input, Length, MAX_STEPS, MAX_THREADS, RunOptions, SolverChoice};
 use setup::{check_outputs, configure, set_threads, start, steps_of};
 
@@ -34,7 +34,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
     let interrupts = Interrupts::install()?;
     // Before any App, resumed or new, is made: neither changes a result.
     set_threads(options.threads);
-    crate::vector::allow(options.vector);
+    crate::base::vector::allow(options.vector);
     let (mut app, mut progress, source, dt) = match &options.input {
         Input::Resume(path) => {
             let spawn = options.placement.is_some() || options.area_fraction.is_some();
@@ -103,7 +103,11 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  eta {eta}")
             .expect("valid template"),
     );
-    let sampling = default_sampling(app.world().resource::<crate::spawn::SpawnReport>().placed);
+    let sampling = default_sampling(
+        app.world()
+            .resource::<crate::game::spawn::SpawnReport>()
+            .placed,
+    );
     // What could not be written; the other outputs are written all the same.
     let mut failed: Vec<anyhow::Error> = Vec::new();
     // Whether a sample's state has left the range of values. Nothing of such a state may be

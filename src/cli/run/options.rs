@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use crate::arena::Boundary;
-use crate::config::{ParseSolverError, Placement, Solver};
+use crate::base::arena::Boundary;
+use crate::base::config::{ParseSolverError, Placement, Solver};
 
 /// Most threads `--threads` may ask for: far more than any machine this runs on has cores, and
 /// few enough that starting them cannot exhaust the process.

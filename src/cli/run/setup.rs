@@ -6,14 +6,14 @@ use anyhow::{Context, bail};
 use bevy::prelude::App;
 
 use super::options::{Input, Length, MAX_STEPS, RunOptions, SolverChoice};
-use crate::accuracy::auto::choose_solver;
-use crate::config::{CirclesConfig, Placement, Solver};
-use crate::error::InputError;
-use crate::io::{check_output_path, same_output};
-use crate::run::headless_app_with;
-use crate::scene::{Scene, particles};
-use crate::schedule::StopRequest;
-use crate::spawn::SpawnReport;
+use crate::base::config::{CirclesConfig, Placement, Solver};
+use crate::base::error::InputError;
+use crate::base::io::{check_output_path, same_output};
+use crate::game::spawn::SpawnReport;
+use crate::step::schedule::StopRequest;
+use crate::tools::accuracy::auto::choose_solver;
+use crate::tools::run::headless_app_with;
+use crate::tools::scene::{Scene, particles};
 
 /// Circles above which `run` says it is placing them before it starts (placing millions takes
 /// seconds to minutes).

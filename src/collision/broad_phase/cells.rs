@@ -5,7 +5,7 @@
 use bevy::math::DVec2;
 use bevy::tasks::{ComputeTaskPool, ParallelSlice, ParallelSliceMut, TaskPool};
 
-use crate::grid::Grid;
+use crate::base::grid::Grid;
 
 /// Circles bucketed by cell: `order[start[c]..start[c + 1]]` are the circles in cell `c`.
 #[derive(Debug, Default, Clone)]

@@ -9,7 +9,7 @@ use bevy::math::DVec2;
 
 use super::cells::{CellList, radius_range};
 use super::scan::{single_level_pairs, sort_and_dedupe, visit_single_level};
-use crate::arena::Arena;
+use crate::base::arena::Arena;
 
 /// Most size levels: a factor of 4 each, so 4⁶⁴ ≈ 3·10³⁸ between the smallest and largest
 /// circle before the largest are lumped together (correct, just slower).

@@ -15,7 +15,7 @@ use std::ops::ControlFlow;
 
 use bevy::math::DVec2;
 
-use crate::arena::Arena;
+use crate::base::arena::Arena;
 pub use cells::{CellList, PARALLEL_FROM, radius_range};
 pub use scan::pairs_in_cell_order;
 
@@ -35,8 +35,8 @@ pub fn needs_levels((r_min, r_max): (f64, f64)) -> bool {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::arena::Arena;
-/// use moving_circles::collide::broad_phase::{CellList, overlapping_pairs};
+/// use moving_circles::base::arena::Arena;
+/// use moving_circles::collision::broad_phase::{CellList, overlapping_pairs};
 ///
 /// let circles = [(DVec2::ZERO, 0.5), (DVec2::new(0.9, 0.0), 0.5), (DVec2::new(3.0, 0.0), 0.5)];
 /// let mut pairs = Vec::new();
@@ -65,8 +65,8 @@ pub fn overlapping_pairs(
 /// ```
 /// use std::ops::ControlFlow;
 /// use bevy::math::DVec2;
-/// use moving_circles::arena::Arena;
-/// use moving_circles::collide::broad_phase::visit_overlapping_pairs;
+/// use moving_circles::base::arena::Arena;
+/// use moving_circles::collision::broad_phase::visit_overlapping_pairs;
 ///
 /// // 1000 circles at one point overlap in 499 500 pairs; the visit stops after the first.
 /// let circles = vec![(DVec2::ZERO, 0.5); 1000];
@@ -94,7 +94,7 @@ pub fn visit_overlapping_pairs(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

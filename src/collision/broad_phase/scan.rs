@@ -9,7 +9,7 @@ use bevy::math::DVec2;
 use bevy::tasks::{ComputeTaskPool, TaskPool};
 
 use super::cells::{CellList, PARALLEL_FROM, map_chunks};
-use crate::arena::{Arena, minimum_image};
+use crate::base::arena::{Arena, minimum_image};
 
 /// The single-grid broad phase, for circles of similar size: buckets `circles` (centre, reach)
 /// into `cells` (one largest diameter, `2 · max_radius`, wide), copies them into `sorted` in

@@ -1,6 +1,6 @@
 //! The index behind the spatial queries: the circles binned into cell lists by the broad
 //! phase's counting sort ([`CellList`]), one list per size level when radii span more than
-//! [`MULTI_LEVEL_RATIO`](crate::collide::broad_phase::MULTI_LEVEL_RATIO), each cell's circles
+//! [`MULTI_LEVEL_RATIO`](crate::collision::broad_phase::MULTI_LEVEL_RATIO), each cell's circles
 //! stored side by side. A query near a point looks at the few cells around it; a ray walks
 //! the cells it crosses in order (a grid traversal), testing the circles of the cells within
 //! reach of each, and stops at the first cell past its nearest hit.
@@ -8,9 +8,9 @@
 use bevy::math::DVec2;
 
 use super::shapes::ray_disc;
-use crate::arena::Arena;
-use crate::collide::broad_phase::{CellList, needs_levels, radius_range};
-use crate::grid::Grid;
+use crate::base::arena::Arena;
+use crate::base::grid::Grid;
+use crate::collision::broad_phase::{CellList, needs_levels, radius_range};
 
 /// How far a ray or a cast travels through the seams of a periodic arena at most: this many of
 /// the box's diagonals (a ray on a torus can wind on without end).

@@ -12,7 +12,7 @@
 //!     query.ray_cast(DVec2::ZERO, DVec2::X, f64::INFINITY, &QueryFilter::default())
 //! }
 //!
-//! let mut app = moving_circles::run::headless_app(CirclesConfig::default());
+//! let mut app = moving_circles::tools::run::headless_app(CirclesConfig::default());
 //! let target = app.world_mut().spawn((Radius(0.5), Position(DVec2::new(3.0, 0.0)))).id();
 //! app.update(); // a step: the index sees the circles as they are after it
 //! let hit = app.world_mut().run_system_cached(aim).unwrap().unwrap();
@@ -27,7 +27,7 @@
 //! asks nothing pays nothing. Circles spawned, moved or despawned by game code after that
 //! build are seen from the next step on, or at once after [`SpatialQuery::refresh`]. Segment
 //! walls are tested one by one (a scene has at most
-//! [`MAX_SEGMENTS`](crate::segment::MAX_SEGMENTS)).
+//! [`MAX_SEGMENTS`](crate::base::segment::MAX_SEGMENTS)).
 
 pub mod index;
 pub mod shapes;
@@ -40,11 +40,11 @@ use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::collision_layers::{CollisionLayers, Sensor};
-use crate::components::{Position, Radius};
-use crate::hits::{ArenaWall, Wall};
-use crate::segment::{Segment, Segments};
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{CollisionLayers, Sensor};
+use crate::base::components::{Position, Radius};
+use crate::base::hits::{ArenaWall, Wall};
+use crate::base::segment::{Segment, Segments};
 use index::CircleIndex;
 use shapes::{disc_contact, ray_capsule, segment_contact};
 

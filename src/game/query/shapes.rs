@@ -7,8 +7,8 @@
 
 use bevy::math::DVec2;
 
-use crate::exact::toi::{pair_time_of_impact, segment_time_of_impact};
-use crate::segment::Segment;
+use crate::base::segment::Segment;
+use crate::collision::toi::{pair_time_of_impact, segment_time_of_impact};
 
 /// Distance `t ≥ 0` along the unit `direction` from `origin` at which the ray first meets the
 /// solid disc of `radius` about `centre`, or `None` if it never does. 0 if `origin` is inside
@@ -16,7 +16,7 @@ use crate::segment::Segment;
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::query::shapes::ray_disc;
+/// use moving_circles::game::query::shapes::ray_disc;
 ///
 /// assert_eq!(ray_disc(DVec2::ZERO, DVec2::X, DVec2::new(3.0, 0.0), 1.0), Some(2.0));
 /// assert_eq!(ray_disc(DVec2::ZERO, -DVec2::X, DVec2::new(3.0, 0.0), 1.0), None);
@@ -38,8 +38,8 @@ pub fn ray_disc(origin: DVec2, direction: DVec2, centre: DVec2, radius: f64) -> 
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::query::shapes::ray_capsule;
-/// use moving_circles::segment::Segment;
+/// use moving_circles::game::query::shapes::ray_capsule;
+/// use moving_circles::base::segment::Segment;
 ///
 /// let floor = Segment::new(DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0));
 /// assert_eq!(ray_capsule(DVec2::new(0.0, 3.0), -DVec2::Y, &floor, 0.0), Some(3.0));

@@ -8,14 +8,14 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::components::Position;
-use crate::components::Radius;
-use crate::config::{DropConfig, SpawnConfig};
-use crate::schedule::CircleSystems;
-use crate::schedule::{StepTotals, StopRequest};
-use crate::segment::Segments;
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::components::Position;
+use crate::base::components::Radius;
+use crate::base::config::{DropConfig, SpawnConfig};
+use crate::base::segment::Segments;
+use crate::step::schedule::CircleSystems;
+use crate::step::schedule::{StepTotals, StopRequest};
 
 mod place;
 

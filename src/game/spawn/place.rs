@@ -10,14 +10,14 @@ use bevy::math::DVec2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::config::{Placement, SpawnConfig};
-use crate::error::FieldError;
-use crate::exact::pack::{PACK_START_FRACTION, compress};
-use crate::grid::{CellMembers, Grid};
-use crate::lattice::lattice_sites;
-use crate::segment::{Segment, SegmentCells};
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::config::{Placement, SpawnConfig};
+use crate::base::error::FieldError;
+use crate::base::grid::{CellMembers, Grid};
+use crate::base::lattice::lattice_sites;
+use crate::base::segment::{Segment, SegmentCells};
+use crate::solvers::exact::pack::{PACK_START_FRACTION, compress};
 
 /// Places up to [`SpawnConfig::target_count`] non-overlapping circles inside `arena`, largest
 /// first, around the `fixed` circles already there (which are not returned) and clear of the
@@ -29,7 +29,7 @@ use crate::segment::{Segment, SegmentCells};
 ///
 /// ```
 /// use moving_circles::prelude::*;
-/// use moving_circles::spawn::place_circles;
+/// use moving_circles::game::spawn::place_circles;
 ///
 /// let config = SpawnConfig { count: 100, ..SpawnConfig::default() };
 /// let circles = place_circles(&Arena::default(), &config, &[], &[]).unwrap();

@@ -9,13 +9,13 @@ use std::sync::{Arc, Mutex};
 
 use bevy::prelude::*;
 
-use crate::accuracy::{Case, HORIZON_SECONDS, Row, SOLVERS, compare, trace};
-use crate::arena::Arena;
-use crate::circle::snapshot;
-use crate::config::{CirclesConfig, DropConfig, Effects, SoftConfig, Solver, SpawnConfig};
-use crate::scene::check::first_overlap;
-use crate::segment::Segments;
-use crate::spawn::FixedCircles;
+use crate::base::arena::Arena;
+use crate::base::circle::snapshot;
+use crate::base::config::{CirclesConfig, DropConfig, Effects, SoftConfig, Solver, SpawnConfig};
+use crate::base::segment::Segments;
+use crate::game::spawn::FixedCircles;
+use crate::tools::accuracy::{Case, HORIZON_SECONDS, Row, SOLVERS, compare, trace};
+use crate::tools::scene::check::first_overlap;
 
 /// Simulated seconds each solver runs in a comparison.
 pub const COMPARE_SECONDS: f64 = 2.0;

@@ -1,7 +1,7 @@
 //! What the panel's sliders and toggles ask for, as [`Control`] messages, and
 //! [`apply_controls`], which makes each change the way a reloaded scene does: effects by writing
 //! the resource, which the next step reconciles
-//! ([`reconcile_effects`](crate::effects::reconcile_effects): an effect switched off loses its
+//! ([`reconcile_effects`](crate::step::effects::reconcile_effects): an effect switched off loses its
 //! systems), the step through the fixed
 //! clock, the count through a respawn; `Compare` starts the background comparison. A value that fails the scene's own checks is refused
 //! with a warning, never clamped.
@@ -12,9 +12,9 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::compare::start_comparison;
-use crate::config::{CirclesConfig, Effects, Solver, SpawnConfig};
-use crate::schedule::allow_long_steps;
-use crate::spawn::Respawn;
+use crate::base::config::{CirclesConfig, Effects, Solver, SpawnConfig};
+use crate::game::spawn::Respawn;
+use crate::step::schedule::allow_long_steps;
 
 /// One change asked for in the panel.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]

@@ -8,13 +8,13 @@ use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::collide::PairCollisions;
-use crate::collide::overlaps::Overlaps;
-use crate::collision_layers::{LayeredDisc, layered_disc};
-use crate::config::Solver;
-use crate::diagnostics::{CircleDiagnostics, Pressure};
-use crate::schedule::StepTotals;
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{LayeredDisc, layered_disc};
+use crate::base::config::Solver;
+use crate::base::hits::PairCollisions;
+use crate::collision::overlaps::Overlaps;
+use crate::game::diagnostics::{CircleDiagnostics, Pressure};
+use crate::step::schedule::StepTotals;
 
 /// Seconds of real time between samples.
 pub const SAMPLE_SECONDS: f64 = 0.25;

@@ -13,10 +13,10 @@ use super::PanelOpen;
 use super::compare::{COMPARE_SECONDS, Comparison};
 use super::controls::{Control, SPEED_RANGE};
 use super::live::{LiveHistory, LiveSample};
-use crate::accuracy::Row;
-use crate::config::{Effects, Solver};
-use crate::diagnostics::CircleDiagnostics;
+use crate::base::config::{Effects, Solver};
+use crate::game::diagnostics::CircleDiagnostics;
 use crate::render::input::{APP_SOLVERS, MAX_COUNT};
+use crate::tools::accuracy::Row;
 
 /// Slider values being dragged: a change that respawns is sent when the drag ends.
 #[derive(Resource, Clone, Copy, Debug, Default)]

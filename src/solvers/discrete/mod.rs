@@ -1,27 +1,22 @@
-//! Circle-circle collisions. [`CollidePlugin`] schedules the `discrete` solvers' collision
+//! The course's method, `discrete` and `substeps=N`: the step's forces, integration and walls
+//! (`crate::step`), then circle-circle collisions. [`CollidePlugin`] schedules the collision
 //! system when the scene calls for collisions: it gathers the circles into the [`pass`]'s flat
-//! arrays, which finds overlapping pairs with the [`broad_phase`] and resolves each with the
-//! [`contact`] kernel, and scatters the result back. On a periodic arena pairs interact across
-//! the seam through the minimum image. Pair collisions are counted here ([`PairCollisions`]),
-//! by whichever solver makes them; [`overlaps`] measures overlap in any state; [`pair_list`]
-//! keeps the broad phase's pairs from step to step for a solver whose circles move little.
+//! arrays, which finds overlapping pairs with the broad phase and resolves each with the
+//! contact kernel (both in `crate::collision`), and scatters the result back. On a periodic
+//! arena pairs interact across the seam through the minimum image.
 
-pub mod broad_phase;
-pub mod contact;
-pub mod overlaps;
-pub mod pair_list;
 pub mod pass;
 
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::collision_layers::CircleFilters;
-use crate::components::{Restitution, SolverCircles};
-use crate::config::Effects;
-use crate::effects::{Effect, register_effect};
-use crate::hits::{CircleHit, HitLog};
-use crate::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
+use crate::base::arena::Arena;
+use crate::base::collision_layers::CircleFilters;
+use crate::base::components::{Restitution, SolverCircles};
+use crate::base::config::Effects;
+use crate::base::hits::{CircleHit, HitLog, PairCollisions};
+use crate::step::effects::{Effect, register_effect};
+use crate::step::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
 use pass::{ContactScratch, resolve_all_contacts};
 
 /// Resolves overlaps between circles: separation plus restitution impulse (`effects.restitution`),
@@ -39,38 +34,6 @@ impl Plugin for CollidePlugin {
                 .in_set(CircleSystems::Collide)
                 .into_configs()
         });
-    }
-}
-
-/// Circle-circle collisions since the last (re)spawn, under any solver.
-#[derive(
-    Resource, Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize,
-)]
-pub struct PairCollisions {
-    /// Impulses applied.
-    pub count: u64,
-    /// Collisional virial `Σ (r_a + r_b) · j` over those impulses (for the pressure).
-    pub virial: f64,
-    /// Kinetic energy that immovable (static or kinematic) circles gave the others: with
-    /// elastic hits, the energy a kinematic paddle injected (a static peg gives none).
-    pub immovable_work: f64,
-    /// Momentum that immovable circles gave the others.
-    pub immovable_impulse: bevy::math::DVec2,
-}
-
-impl PairCollisions {
-    /// The collisions between `earlier` and these counters (all zero across a respawn, which
-    /// restarts the counters).
-    pub fn since(&self, earlier: &PairCollisions) -> PairCollisions {
-        if self.count < earlier.count {
-            return PairCollisions::default();
-        }
-        PairCollisions {
-            count: self.count - earlier.count,
-            virial: self.virial - earlier.virial,
-            immovable_work: self.immovable_work - earlier.immovable_work,
-            immovable_impulse: self.immovable_impulse - earlier.immovable_impulse,
-        }
     }
 }
 

@@ -5,15 +5,15 @@
 
 use bevy::math::DVec2;
 
-use super::broad_phase::{
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::collision_layers::{CollisionLayers, pair_meets};
+use crate::base::hits::{CircleHit, HitLog};
+use crate::collision::broad_phase::{
     CellList, needs_levels, overlapping_pairs, pairs_in_cell_order, radius_range,
 };
-use super::contact::{combine_restitution, resolve_contact, work_by_immovable};
-use crate::arena::Arena;
-use crate::boundary::put_back_inside;
-use crate::circle::CircleState;
-use crate::collision_layers::{CollisionLayers, pair_meets};
-use crate::hits::{CircleHit, HitLog};
+use crate::collision::contact::{combine_restitution, resolve_contact, work_by_immovable};
+use crate::step::boundary::put_back_inside;
 
 /// The circles of one collision pass, and buffers reused from pass to pass so the hot path
 /// does not allocate. Centres and radii sit together (what the broad phase reads); velocities
@@ -229,7 +229,7 @@ pub fn separate_overlaps(circles: &mut [CircleState], arena: &Arena) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
 
     #[test]
     fn separation_never_pushes_a_centre_out_of_the_arena() {

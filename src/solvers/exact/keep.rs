@@ -10,16 +10,16 @@ use bevy::prelude::*;
 
 use super::engine::{EngineSnapshot, EventEngine, EventStats, Rest, Roughness};
 use super::outside::{moved_since, turning_of};
-use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::collision_layers::CircleFilters;
-use crate::components::{
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::collision_layers::CircleFilters;
+use crate::base::components::{
     AngularVelocity, Inertia, Mass, Position, Radius, Restitution, Rotation, Sleep, SolverCircles,
     SpinCircles, Velocity,
 };
-use crate::config::{Effects, Solver};
-use crate::schedule::StopRequest;
-use crate::segment::Segments;
+use crate::base::config::{Effects, Solver};
+use crate::base::segment::Segments;
+use crate::step::schedule::StopRequest;
 
 /// `exact` updates its engine in place when at most one circle in this many was moved from
 /// outside since the last step, and rebuilds it when more were (each update costs about what a

@@ -17,29 +17,25 @@
 //! change-tick check and one write per circle, not for comparing every circle's values.
 
 pub mod engine;
-pub mod fall;
 mod keep;
 mod outside;
 pub mod pack;
 pub mod queue;
-pub mod roots;
-pub mod rough;
-pub mod toi;
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::boundary::WallCollisions;
-use crate::collide::PairCollisions;
-use crate::collision_layers::{CircleFilters, CollisionLayers, Sensor};
-use crate::components::{Inertia, Radius, Restitution, Sleep, SolverCircles, SpinCircles};
-use crate::config::{Effects, Solver};
-use crate::hits::{CircleHit, WallHit};
-use crate::integrate::turn_circles;
-use crate::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
-use crate::segment::Segments;
-use crate::sleep::Sleeping;
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{CircleFilters, CollisionLayers, Sensor};
+use crate::base::components::{Inertia, Radius, Restitution, Sleep, SolverCircles, SpinCircles};
+use crate::base::config::{Effects, Solver};
+use crate::base::hits::PairCollisions;
+use crate::base::hits::{CircleHit, WallHit};
+use crate::base::segment::Segments;
+use crate::step::boundary::WallCollisions;
+use crate::step::integrate::turn_circles;
+use crate::step::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
+use crate::step::sleep::Sleeping;
 use keep::{EngineViews, Own, gather_into_engine};
 
 pub use keep::EngineState;

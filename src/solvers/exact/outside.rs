@@ -7,7 +7,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::engine::EventEngine;
-use crate::components::{Restitution, SolverCircles, SpinCircles};
+use crate::base::components::{Restitution, SolverCircles, SpinCircles};
 
 /// What user code did to one circle of a kept engine since it last wrote it back.
 pub(super) struct Moved {

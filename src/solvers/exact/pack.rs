@@ -5,8 +5,8 @@
 use bevy::math::DVec2;
 
 use super::engine::EventEngine;
-use crate::arena::Arena;
-use crate::circle::CircleState;
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
 
 /// The area fraction a `pack` placement places circles at before compressing them.
 pub const PACK_START_FRACTION: f64 = 0.25;
@@ -104,7 +104,7 @@ pub fn compress(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
 
     #[test]
     fn a_compression_asked_to_stop_gives_up_and_one_never_asked_grows_the_circles() {

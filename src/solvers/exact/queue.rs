@@ -15,7 +15,7 @@
 //! of the pending times whenever the queue is laid out, at the start and every few updates per
 //! circle.
 
-use crate::grid::{CellMembers, NONE};
+use crate::base::grid::{CellMembers, NONE};
 
 /// Where a circle's time is kept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

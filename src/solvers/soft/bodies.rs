@@ -5,8 +5,8 @@ use std::f64::consts::TAU;
 
 use bevy::math::DVec2;
 
-use crate::circle::inverse_inertia;
-use crate::collision_layers::CollisionLayers;
+use crate::base::circle::inverse_inertia;
+use crate::base::collision_layers::CollisionLayers;
 
 /// The circles of one `soft` step, as plain arrays in one order (the solver's query's).
 #[derive(Clone, Debug, Default)]
@@ -138,7 +138,7 @@ impl Softness {
     /// A spring of `hertz` with damping ratio `zeta`, for substeps of `h` seconds.
     ///
     /// ```
-    /// use moving_circles::soft::Softness;
+    /// use moving_circles::solvers::soft::Softness;
     ///
     /// let soft = Softness::new(30.0, 10.0, 1.0 / 240.0);
     /// // Nearly rigid impulses, an overlap fed back at under ω / (2ζ) per second.

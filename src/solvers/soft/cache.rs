@@ -8,10 +8,10 @@ use bevy::platform::collections::HashMap;
 use serde::{Deserialize, Serialize};
 
 use super::contacts::{Constraint, Partner, TurningRow};
-use crate::circle::CircleState;
-use crate::grid::NONE;
-use crate::hits::Wall;
-use crate::range::MAX_MAGNITUDE;
+use crate::base::circle::CircleState;
+use crate::base::grid::NONE;
+use crate::base::hits::Wall;
+use crate::base::range::MAX_MAGNITUDE;
 
 /// Most a cached impulse may change a circle's velocity by, in units of the largest speed an
 /// input may give: two circles at that speed meeting head-on trade four times it, and a

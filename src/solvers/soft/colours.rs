@@ -179,7 +179,7 @@ pub enum Pass {
 }
 
 /// One pass over the groups of `colours`, colour after colour, on circles at `position` moving
-/// at `velocity`: with AVX2 where the processor has it (and [`crate::vector::allow`] lets it),
+/// at `velocity`: with AVX2 where the processor has it (and [`crate::base::vector::allow`] lets it),
 /// else lane by lane; the same result either way.
 pub fn passes(
     colours: &mut Colours,
@@ -189,7 +189,7 @@ pub fn passes(
     work: &mut Work,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if crate::vector::avx2() {
+    if crate::base::vector::avx2() {
         // SAFETY: the processor has AVX2, all that `wide::passes` asks of it.
         return unsafe { wide::passes(colours, position, velocity, pass, work) };
     }

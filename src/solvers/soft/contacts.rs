@@ -8,14 +8,14 @@ use bevy::math::DVec2;
 use super::bodies::{Bodies, Softness};
 pub use super::rules::ContactRules;
 use super::rules::impact;
-use crate::arena::Arena;
-use crate::collide::contact::{combine_restitution, contact_normal};
-use crate::collide::pair_list::{PairList, SKIN};
-use crate::collision_layers::{meets_any, pair_meets};
-use crate::exact::toi::pair_time_of_impact;
-use crate::grid::NONE;
-use crate::hits::{ArenaWall, Wall};
-use crate::segment::{Segment, SegmentCells};
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{meets_any, pair_meets};
+use crate::base::grid::NONE;
+use crate::base::hits::{ArenaWall, Wall};
+use crate::base::segment::{Segment, SegmentCells};
+use crate::collision::contact::{combine_restitution, contact_normal};
+use crate::collision::pair_list::{PairList, SKIN};
+use crate::collision::toi::pair_time_of_impact;
 
 /// Gap (as a fraction of the smaller radius) within which circles at rest relative to each
 /// other get a contact: Box2D's speculative distance (four linear slops, 2 cm) for bodies of

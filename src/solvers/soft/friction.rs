@@ -14,7 +14,7 @@ use bevy::math::DVec2;
 
 use super::bodies::Bodies;
 use super::contacts::{Constraint, TurningRow};
-use crate::grid::NONE;
+use crate::base::grid::NONE;
 
 /// The tangent of normal `n`: `n` turned a quarter turn counter-clockwise.
 #[inline]
@@ -120,7 +120,7 @@ pub fn solve_turning(bodies: &mut Bodies, c: &Constraint, row: &mut TurningRow) 
 pub fn turn(bodies: &mut Bodies, h: f64) {
     for (angle, &w) in bodies.rotation.iter_mut().zip(&bodies.angular_velocity) {
         if w != 0.0 {
-            *angle = crate::components::Rotation(*angle).turned(w * h).0;
+            *angle = crate::base::components::Rotation(*angle).turned(w * h).0;
         }
     }
 }
@@ -128,9 +128,9 @@ pub fn turn(bodies: &mut Bodies, h: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hits::{ArenaWall, Wall};
-    use crate::soft::bodies::Softness;
-    use crate::soft::contacts::Partner;
+    use crate::base::hits::{ArenaWall, Wall};
+    use crate::solvers::soft::bodies::Softness;
+    use crate::solvers::soft::contacts::Partner;
 
     /// A disc of unit mass and radius resting on a floor below it, moving at `v` and turning
     /// at `w`, with friction `mu` and a normal push of 1 held.

@@ -4,7 +4,7 @@
 use bevy::math::DVec2;
 
 use super::bodies::Softness;
-use crate::config::Combine;
+use crate::base::config::Combine;
 
 /// The tuning every contact of a step shares.
 #[derive(Clone, Copy, Debug)]

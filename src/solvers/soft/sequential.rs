@@ -8,7 +8,7 @@ use super::bodies::{Bodies, Softness};
 use super::contacts::{Constraint, TurningRow, larger};
 use super::friction::{solve_turning, warm_start_turning};
 use super::stats::Work;
-use crate::grid::NONE;
+use crate::base::grid::NONE;
 
 /// Applies impulse `j` along contact `c`'s normal (to `a` against it, to `b` along it); `WALL`
 /// says whether `c` is a wall's (which has no `b`), so each kind of contact gets its own loop.

@@ -22,11 +22,11 @@ use super::contacts::{
 use super::friction::turn;
 use super::sequential::{restitution, solve, solve_one, warm_start, warm_start_one};
 use super::stats::{SoftStats, Work, count};
-use crate::arena::Arena;
-use crate::boundary::put_back_inside;
-use crate::config::{Combine, SoftConfig};
-use crate::hits::HitLog;
-use crate::segment::{Segment, SegmentCells};
+use crate::base::arena::Arena;
+use crate::base::config::{Combine, SoftConfig};
+use crate::base::hits::HitLog;
+use crate::base::segment::{Segment, SegmentCells};
+use crate::step::boundary::put_back_inside;
 
 /// What one `soft` step is asked to do besides moving the circles.
 #[derive(Clone, Copy, Debug)]

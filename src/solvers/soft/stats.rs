@@ -6,7 +6,7 @@ use bevy::math::DVec2;
 
 use super::bodies::Bodies;
 use super::contacts::{Constraint, Partner};
-use crate::hits::{CircleHit, HitLog, WallHit};
+use crate::base::hits::{CircleHit, HitLog, WallHit};
 
 /// The work immovable circles did on movable ones through their contacts' impulses, and the
 /// momentum they gave them, added up over a step's passes.

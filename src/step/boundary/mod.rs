@@ -13,13 +13,13 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::collide::contact::combine_restitution;
-use crate::components::{Position, SolverCircles};
-use crate::config::Effects;
-use crate::effects::{Effect, register_effect};
-use crate::hits::{ArenaWall, HitLog, Wall, WallHit};
-use crate::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
+use crate::base::arena::Arena;
+use crate::base::components::{Position, SolverCircles};
+use crate::base::config::Effects;
+use crate::base::hits::{ArenaWall, HitLog, Wall, WallHit};
+use crate::collision::contact::combine_restitution;
+use crate::step::effects::{Effect, register_effect};
+use crate::step::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
 
 pub mod segments;
 
@@ -28,7 +28,7 @@ pub use segments::SegmentsPlugin;
 /// Keeps every circle inside the [`Arena`] by reflecting it off the walls, when the arena has
 /// walls, under `discrete` and `substeps=N`. (`soft`, `swept` and `exact` hit the walls inside
 /// their own step, whether or not this plugin is in: an arena without walls is
-/// [`Boundary::Open`](crate::arena::Boundary::Open).)
+/// [`Boundary::Open`](crate::base::arena::Boundary::Open).)
 #[derive(Clone, Copy, Debug, Default)]
 pub struct WallsPlugin;
 
@@ -86,8 +86,8 @@ fn wrap_around(arena: Res<Arena>, mut circles: Query<&mut Position>) {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::arena::{Arena, Boundary};
-/// use moving_circles::boundary::reflect_off_walls;
+/// use moving_circles::base::arena::{Arena, Boundary};
+/// use moving_circles::step::boundary::reflect_off_walls;
 ///
 /// let unit = Arena::unit_square(Boundary::Walls);
 /// // 0.15 past the right wall (centre at most 0.9 with radius 0.1), moving out.
@@ -267,7 +267,7 @@ mod tests {
     use super::*;
 
     fn unit() -> Arena {
-        Arena::unit_square(crate::arena::Boundary::Walls)
+        Arena::unit_square(crate::base::arena::Boundary::Walls)
     }
 
     #[test]

@@ -12,14 +12,14 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::WallCollisions;
-use crate::arena::Arena;
-use crate::collide::contact::combine_restitution;
-use crate::components::SolverCircles;
-use crate::config::Effects;
-use crate::effects::{Effect, EffectSystems, register_effect};
-use crate::hits::{HitLog, Wall, WallHit};
-use crate::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
-use crate::segment::{Segment, SegmentCells, Segments};
+use crate::base::arena::Arena;
+use crate::base::components::SolverCircles;
+use crate::base::config::Effects;
+use crate::base::hits::{HitLog, Wall, WallHit};
+use crate::base::segment::{Segment, SegmentCells, Segments};
+use crate::collision::contact::combine_restitution;
+use crate::step::effects::{Effect, EffectSystems, register_effect};
+use crate::step::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
 
 /// Reflects circles off the scene's segment walls (before the arena walls, which then have the
 /// last word on keeping every circle inside).
@@ -64,8 +64,8 @@ pub struct SegmentBounce {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::boundary::segments::reflect_off_segment;
-/// use moving_circles::segment::Segment;
+/// use moving_circles::step::boundary::segments::reflect_off_segment;
+/// use moving_circles::base::segment::Segment;
 ///
 /// let floor = Segment::new(DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0));
 /// let (mut p, mut v) = (DVec2::new(0.0, 0.4), DVec2::new(1.0, -2.0));

@@ -5,11 +5,11 @@
 
 use bevy::math::DVec2;
 
-use crate::arena::Arena;
-use crate::collide::broad_phase::{CellList, overlapping_pairs};
-use crate::collide::pair_list::{PairList, SKIN};
-use crate::collision_layers::{CollisionLayers, pair_meets};
-use crate::components::Sleep;
+use crate::base::arena::Arena;
+use crate::base::collision_layers::{CollisionLayers, pair_meets};
+use crate::base::components::Sleep;
+use crate::collision::broad_phase::{CellList, overlapping_pairs};
+use crate::collision::pair_list::{PairList, SKIN};
 
 /// Gap (in the smaller radius) within which two circles count as touching for an island.
 pub const TOUCHING: f64 = 0.05;

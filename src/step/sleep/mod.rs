@@ -18,13 +18,13 @@ use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::arena::Arena;
-use crate::collision_layers::CircleFilters;
-use crate::components::{AngularVelocity, Mass, Position, Radius, Sleep, Velocity};
-use crate::config::{Effects, SleepConfig, Solver};
-use crate::effects::{Effect, register_effect};
-use crate::schedule::{CircleSystems, StepTotals};
-use crate::segment::Segments;
+use crate::base::arena::Arena;
+use crate::base::collision_layers::CircleFilters;
+use crate::base::components::{AngularVelocity, Mass, Position, Radius, Sleep, Velocity};
+use crate::base::config::{Effects, SleepConfig, Solver};
+use crate::base::segment::Segments;
+use crate::step::effects::{Effect, register_effect};
+use crate::step::schedule::{CircleSystems, StepTotals};
 pub use islands::{IslandScratch, Islands, Resting, TOUCHING, fall_asleep, wake_touched};
 
 pub mod islands;

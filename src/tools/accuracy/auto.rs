@@ -2,7 +2,7 @@
 //! measured against `exact`, and the cheapest candidate within the tolerance.
 
 use super::measure::{Case, HORIZON_SECONDS, SOLVERS, compare, trace};
-use crate::config::{CirclesConfig, Solver};
+use crate::base::config::{CirclesConfig, Solver};
 
 /// One candidate of `--solver auto`: its error (the larger of position error and max
 /// penetration, both in radii) and cost after the calibration run.

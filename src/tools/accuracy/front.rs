@@ -3,7 +3,7 @@
 //! ([`pareto_front`]): the settings that no cheaper setting matches.
 
 use super::measure::{REFERENCE_DT, Row};
-use crate::config::Solver;
+use crate::base::config::Solver;
 
 /// One error measure the figure plots against cost.
 #[derive(Clone, Copy, Debug)]

@@ -22,12 +22,12 @@
 use bevy::math::DVec2;
 use serde::Serialize;
 
-use crate::arena::Arena;
-use crate::circle::{CircleState, snapshot};
-use crate::collide::broad_phase::{CellList, overlapping_pairs};
-use crate::config::{CirclesConfig, Solver};
-use crate::diagnostics::relative_change;
-use crate::run::{Report, headless_app, run_steps};
+use crate::base::arena::Arena;
+use crate::base::circle::{CircleState, snapshot};
+use crate::base::config::{CirclesConfig, Solver};
+use crate::collision::broad_phase::{CellList, overlapping_pairs};
+use crate::game::diagnostics::relative_change;
+use crate::tools::run::{Report, headless_app, run_steps};
 
 /// Default simulated time after which positions are compared with the reference: a few
 /// collisions per circle in the study's gases, before chaos makes every comparison meaningless.

@@ -24,9 +24,9 @@ pub use measure::{
     Case, HORIZON_SECONDS, REFERENCE_DT, Row, SOLVERS, Trace, compare, passed_through, trace,
 };
 
-use crate::config::{CirclesConfig, Solver};
-use crate::error::InputError;
-use crate::scene::Scene;
+use crate::base::config::{CirclesConfig, Solver};
+use crate::base::error::InputError;
+use crate::tools::scene::Scene;
 
 /// The solvers and steps every case is run with: one step size when `quick`.
 pub fn settings(quick: bool) -> Vec<(Solver, f64)> {

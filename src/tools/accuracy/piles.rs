@@ -15,8 +15,8 @@
 use serde::Serialize;
 
 use super::measure::Case;
-use crate::config::Solver;
-use crate::run::{headless_app, run_steps};
+use crate::base::config::Solver;
+use crate::tools::run::{headless_app, run_steps};
 
 /// Kinetic energy (over `N·m·g·r`) below which a pile counts as settled.
 pub const SETTLED: f64 = 1e-4;
@@ -71,7 +71,7 @@ pub struct PileRow {
 /// Runs the pile `case` (a scene with gravity) under `solver` at step `dt` and measures it.
 /// A `soft` solver keeps the scene's own contact settings.
 pub fn measure_pile(case: &Case, solver: Solver, dt: f64) -> PileRow {
-    let config = crate::config::CirclesConfig {
+    let config = crate::base::config::CirclesConfig {
         solver,
         dt,
         ..case.config.clone()

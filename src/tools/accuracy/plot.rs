@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::front::{MEASURES, Measure, Panel, cost, of_scene, rate, scenes};
 use super::measure::Row;
-use crate::figure::{Figure, decades, err, font};
+use crate::tools::figure::{Figure, decades, err, font};
 
 /// The figure's size in pixels (SVG user units and PNG pixels alike).
 pub const FIGURE_SIZE: (u32, u32) = (1600, 1290);

@@ -6,8 +6,8 @@ use std::io::Read;
 use std::path::Path;
 
 use super::{Checkpoint, MAX_CHECKPOINT_BYTES};
-use crate::error::InputError;
-use crate::io::read_bytes_limited;
+use crate::base::error::InputError;
+use crate::base::io::read_bytes_limited;
 
 /// The first field of every checkpoint: what it is and the layout's version.
 pub(super) const FORMAT: &str = "moving_circles checkpoint 10";
@@ -25,7 +25,7 @@ fn check_format(bytes: &[u8], origin: &str) -> Result<(), InputError> {
             origin,
             format!(
                 "written by another version ({}), this one reads `{FORMAT}`",
-                crate::io::printable(other)
+                crate::base::io::printable(other)
             ),
         )),
         _ => Err(not_one()),

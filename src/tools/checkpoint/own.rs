@@ -8,9 +8,9 @@ use bevy::ecs::entity::EntityHashMap;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::collision_layers::{CollisionLayers, Sensor, SensorOverlaps};
-use crate::components::{Friction, Inertia, Restitution};
-use crate::config::MAX_FRICTION;
+use crate::base::collision_layers::{CollisionLayers, Sensor, SensorOverlaps};
+use crate::base::components::{Friction, Inertia, Restitution};
+use crate::base::config::MAX_FRICTION;
 
 /// The parts of its own one circle has (at least one of them).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

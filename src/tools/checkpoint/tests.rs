@@ -149,14 +149,14 @@ fn a_clock_that_is_not_its_steps_is_refused() {
 
 #[test]
 fn parts_of_their_own_out_of_range_or_order_are_refused() {
-    use crate::collision_layers::Sensor;
-    use crate::components::{Friction, Inertia, Restitution};
+    use crate::base::collision_layers::Sensor;
+    use crate::base::components::{Friction, Inertia, Restitution};
     let mut config = CirclesConfig::default();
     config.spawn.count = 8;
     let mut app = headless_app(config);
     let world = app.world_mut();
     let circles: Vec<Entity> = world
-        .query_filtered::<Entity, With<crate::components::Radius>>()
+        .query_filtered::<Entity, With<crate::base::components::Radius>>()
         .iter(world)
         .collect();
     world

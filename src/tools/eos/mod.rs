@@ -18,16 +18,16 @@ pub mod theory;
 use bevy::math::DVec2;
 use serde::Serialize;
 
-use crate::arena::{Arena, Boundary};
-use crate::circle::snapshot;
-use crate::collide::PairCollisions;
-use crate::config::{
+use crate::base::arena::{Arena, Boundary};
+use crate::base::circle::snapshot;
+use crate::base::config::{
     CirclesConfig, DT_RANGE, Effects, MAX_CIRCLES, MassModel, Placement, Solver, SpawnConfig,
 };
-use crate::diagnostics::{CircleDiagnostics, Pressure};
-use crate::error::FieldError;
-use crate::run::headless_app;
-use crate::schedule::StepTotals;
+use crate::base::error::FieldError;
+use crate::base::hits::PairCollisions;
+use crate::game::diagnostics::{CircleDiagnostics, Pressure};
+use crate::step::schedule::StepTotals;
+use crate::tools::run::headless_app;
 use theory::{block_mean, henderson_z, ks_critical_5_percent, liu_z, rayleigh_ks};
 
 /// What to measure.

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::EosPoint;
 use super::theory::{henderson_z, liu_z};
-use crate::figure::{Figure, err, font};
+use crate::tools::figure::{Figure, err, font};
 
 /// Liu's and Henderson's equations are for the fluid: drawn solid up to here.
 pub const FLUID_LIMIT: f64 = 0.65;

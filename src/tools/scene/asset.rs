@@ -11,13 +11,13 @@ use bevy::prelude::*;
 use bevy::tasks::futures_lite::AsyncReadExt;
 
 use super::schema::Scene;
-use crate::arena::Arena;
-use crate::config::{CirclesConfig, DropConfig, Effects, Solver, SpawnConfig};
-use crate::error::InputError;
-use crate::io::{MAX_SCENE_BYTES, printable, read_limited};
-use crate::schedule::allow_long_steps;
-use crate::segment::Segments;
-use crate::spawn::{FixedCircles, Respawn};
+use crate::base::arena::Arena;
+use crate::base::config::{CirclesConfig, DropConfig, Effects, Solver, SpawnConfig};
+use crate::base::error::InputError;
+use crate::base::io::{MAX_SCENE_BYTES, printable, read_limited};
+use crate::base::segment::Segments;
+use crate::game::spawn::{FixedCircles, Respawn};
+use crate::step::schedule::allow_long_steps;
 
 /// A scene file, checked and turned into a configuration.
 #[derive(Asset, TypePath, Clone, Debug)]

@@ -25,13 +25,13 @@ pub mod schema;
 
 pub use schema::{ArenaSpec, CircleSpec, Scene};
 
-use crate::config::CirclesConfig;
+use crate::base::config::CirclesConfig;
 
 /// The built-in default scene, `assets/scenes/classic.ron` (the course exercise), compiled in so
 /// the app opens on it from any directory.
 pub fn classic() -> CirclesConfig {
     const ORIGIN: &str = "assets/scenes/classic.ron";
-    Scene::parse(include_str!("../../assets/scenes/classic.ron"), ORIGIN)
+    Scene::parse(include_str!("../../../assets/scenes/classic.ron"), ORIGIN)
         .and_then(|scene| scene.to_config(ORIGIN))
         .expect("the built-in classic scene is valid (tested)")
 }

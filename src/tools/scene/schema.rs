@@ -6,10 +6,10 @@
 use bevy::math::DVec2;
 use serde::Deserialize;
 
-use crate::arena::Boundary;
-use crate::config::{DropConfig, Effects, MassModel, SoftConfig, Solver, SpawnConfig};
-use crate::error::InputError;
-use crate::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE};
+use crate::base::arena::Boundary;
+use crate::base::config::{DropConfig, Effects, MassModel, SoftConfig, Solver, SpawnConfig};
+use crate::base::error::InputError;
+use crate::base::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE};
 
 /// The arena as a scene file gives it.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
@@ -53,7 +53,7 @@ pub struct CircleSpec {
     /// Colour as sRGB bytes; by default light grey.
     #[serde(default)]
     pub color: Option<[u8; 3]>,
-    /// A static obstacle (a peg): infinite mass ([`Mass::IMMOVABLE`](crate::components::Mass)),
+    /// A static obstacle (a peg): infinite mass ([`Mass::IMMOVABLE`](crate::base::components::Mass)),
     /// at rest for good. Gives no `mass` and no `velocity` (a moving immovable circle is a
     /// kinematic one, which code steers).
     #[serde(default)]

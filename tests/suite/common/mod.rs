@@ -37,7 +37,7 @@ pub fn is_continuous(solver: &str) -> bool {
 /// A headless app running `config`, already past `Startup` (circles spawned), in which every
 /// `update()` advances exactly one fixed step: the same app `moving_circles run` steps.
 pub fn create_app(config: CirclesConfig) -> App {
-    moving_circles::run::headless_app(config)
+    moving_circles::tools::run::headless_app(config)
 }
 
 /// A unit box asked for `fraction` of circles of radii `radius` at speed 1, placed by
@@ -226,7 +226,7 @@ pub fn scene_app(ron: &str) -> App {
 
 /// Short names of the systems in the simulation's schedules.
 pub fn system_names(app: &mut App) -> Vec<String> {
-    moving_circles::schedule::scheduled_systems(app)
+    moving_circles::step::schedule::scheduled_systems(app)
         .into_iter()
         .map(|(_, s)| s.rsplit("::").next().unwrap().to_owned())
         .collect()
@@ -256,9 +256,9 @@ pub fn assert_resumes_as_the_run_goes_on(app: &mut App, steps: u64, what: &str) 
 /// [`assert_resumes_as_the_run_goes_on`], with `then` done to the run and to the resumed one
 /// right after the checkpoint (a kick from user code, say).
 pub fn assert_resumes_through(app: &mut App, then: impl Fn(&mut App), steps: u64, what: &str) {
-    use moving_circles::checkpoint::Checkpoint;
-    use moving_circles::circle::snapshot;
-    use moving_circles::run::Progress;
+    use moving_circles::base::circle::snapshot;
+    use moving_circles::tools::checkpoint::Checkpoint;
+    use moving_circles::tools::run::Progress;
     let progress = Progress::start(app.world_mut());
     let bytes = Checkpoint::take(app.world_mut(), what, &progress).to_bytes();
     let (mut resumed, _) = Checkpoint::from_bytes(&bytes, "test.checkpoint")

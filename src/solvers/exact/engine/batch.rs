@@ -5,7 +5,7 @@
 //! branches as masks), so the two give the same bits. A small circle's full prediction takes
 //! this path when circles fly straight lines (no gravity), radii do not grow and a pair is
 //! looked at through its nearest image only, where the processor has AVX2 and
-//! [`crate::vector::allow`] lets it; `look_at` one by one elsewhere (and for a crossing's look
+//! [`crate::base::vector::allow`] lets it; `look_at` one by one elsewhere (and for a crossing's look
 //! at the three cells it newly borders, cheaper so, and a large circle's look).
 //! Rounding half away from zero, as `f64::round`, is the truncation plus one more where the
 //! part cut off is half or more (both exact).
@@ -231,8 +231,8 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::arena::{Arena, Boundary};
-    use crate::circle::CircleState;
+    use crate::base::arena::{Arena, Boundary};
+    use crate::base::circle::CircleState;
 
     /// Motions that try the kernel's every branch: pairs closing, parting, missing, touching
     /// and overlapping, at rest against each other, references times apart, displacements of

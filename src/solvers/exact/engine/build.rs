@@ -7,12 +7,12 @@ use bevy::math::DVec2;
 use super::EventEngine;
 use super::events::{Event, EventStats, Kind, Motion, NO_PAIR, Rest};
 use super::walls::{Layout, cell_width, walls_inside};
-use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::collision_layers::CollisionLayers;
-use crate::exact::queue::EventQueue;
-use crate::grid::{CellMembers, NONE};
-use crate::segment::Segment;
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::collision_layers::CollisionLayers;
+use crate::base::grid::{CellMembers, NONE};
+use crate::base::segment::Segment;
+use crate::solvers::exact::queue::EventQueue;
 
 /// Predictions between two looks at [`EventEngine::build_until`]'s stop request: a few
 /// milliseconds of work.
@@ -299,7 +299,7 @@ mod tests {
     use std::cell::Cell;
 
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
 
     #[test]
     fn a_build_asked_to_stop_gives_up_and_one_never_asked_is_the_whole_build() {

@@ -4,7 +4,7 @@
 use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::grid::NONE;
+use crate::base::grid::NONE;
 
 /// Counts of what the engine did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -4,8 +4,8 @@
 //! they came, so a compression heats the circles).
 
 use super::{EventEngine, cell_width};
-use crate::arena::Arena;
-use crate::circle::CircleState;
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
 
 impl EventEngine {
     /// An elastic engine whose circles all grow, radius `r` at `r·(1 + growth·t)`, with cells
@@ -57,7 +57,7 @@ mod tests {
     use bevy::math::DVec2;
 
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
 
     #[test]
     fn circles_at_rest_grow_into_each_other_and_part_at_twice_the_growth() {

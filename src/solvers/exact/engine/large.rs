@@ -4,9 +4,9 @@
 //! block of cells its radius reaches. The cells then stay sized for the many, not the few.
 
 use super::EventEngine;
-use crate::circle::CircleState;
-use crate::collision_layers::{CollisionLayers, can_meet};
-use crate::grid::Grid;
+use crate::base::circle::CircleState;
+use crate::base::collision_layers::{CollisionLayers, can_meet};
+use crate::base::grid::Grid;
 
 /// Most circles kept out of the cells: every prediction looks at all of them, so past a handful
 /// one grid for all (cells a largest diameter wide) is cheaper.
@@ -133,7 +133,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::arena::{Arena, Boundary};
+    use crate::base::arena::{Arena, Boundary};
 
     /// Two large circles (radii 0.1 and 0.06) in a gas of 300 of radius 0.004 on a lattice,
     /// with pseudo-random velocities.
@@ -210,7 +210,7 @@ mod tests {
             &[],
             (1.0, 1.0),
             DVec2::ZERO,
-            crate::exact::engine::Roughness::SMOOTH,
+            crate::solvers::exact::engine::Roughness::SMOOTH,
             true,
         )
         .unwrap();

@@ -45,12 +45,12 @@ use walls::{Layout, cell_width, walls_inside};
 use bevy::math::DVec2;
 
 use super::queue::EventQueue;
-use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::collision_layers::{CollisionLayers, can_meet, pair_meets};
-use crate::grid::{CellMembers, Grid};
-use crate::hits::HitLog;
-use crate::segment::{Segment, SegmentCells};
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::collision_layers::{CollisionLayers, can_meet, pair_meets};
+use crate::base::grid::{CellMembers, Grid};
+use crate::base::hits::HitLog;
+use crate::base::segment::{Segment, SegmentCells};
 
 /// Events between two looks at [`EventEngine::advance_until_stopped`]'s stop request: about a
 /// millisecond of events, so a stop is seen at once and asking costs nothing.
@@ -60,9 +60,9 @@ pub const STOP_POLL_EVENTS: u64 = 4096;
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::arena::Arena;
-/// use moving_circles::circle::CircleState;
-/// use moving_circles::exact::engine::EventEngine;
+/// use moving_circles::base::arena::Arena;
+/// use moving_circles::base::circle::CircleState;
+/// use moving_circles::solvers::exact::engine::EventEngine;
 ///
 /// let circles = [
 ///     CircleState::new(DVec2::new(-2.0, 0.0), DVec2::new(1.0, 0.0), 0.5),
@@ -138,7 +138,7 @@ pub struct EventEngine {
 
 impl EventEngine {
     /// Gives each circle its own restitution (one value per circle, in order; empty: all take
-    /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`](crate::collide::contact::combine_restitution).
+    /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`](crate::collision::contact::combine_restitution).
     pub fn set_own_restitutions(&mut self, restitutions: Vec<f64>) {
         assert!(restitutions.is_empty() || restitutions.len() == self.len());
         self.own_restitution = restitutions;

@@ -9,8 +9,8 @@ use bevy::math::DVec2;
 
 use super::EventEngine;
 use super::events::Frame;
-use crate::arena::minimum_image;
-use crate::boundary::reflect_off_walls;
+use crate::base::arena::minimum_image;
+use crate::step::boundary::reflect_off_walls;
 
 impl EventEngine {
     /// How many times the smallest circle that moves falls its own radius (`√(r/g)`) in

@@ -5,10 +5,10 @@
 use bevy::math::DVec2;
 
 use super::EventEngine;
-use crate::collide::contact::{
+use crate::base::hits::CircleHit;
+use crate::collision::contact::{
     apply_impulse, combine_restitution, contact_normal, work_by_immovable,
 };
-use crate::hits::CircleHit;
 
 impl EventEngine {
     pub(super) fn collide(&mut self, i: usize, j: usize) {

@@ -10,7 +10,7 @@
 //!
 //! Under gravity the same is done for parabolas: two falling circles still close at a constant
 //! velocity, so a pair of them takes the straight-line time of impact; a falling circle against
-//! one that does not fall takes the quartic of [`crate::exact::fall`], and walls, segment walls
+//! one that does not fall takes the quartic of [`crate::collision::fall`], and walls, segment walls
 //! and cell edges the parabola's roots. A sleeping circle is at rest: it predicts its pairs
 //! with the circles that fly (the pair a circle falling asleep may now have with a neighbour is
 //! found that way), and no wall or cell event.
@@ -20,11 +20,11 @@ use bevy::math::DVec2;
 use super::EventEngine;
 use super::events::{BestPair, Event, Kind, Motion, NO_PAIR, relative};
 use super::motion::whole_periods;
-use crate::exact::fall::{exit_time, falling_pair_time, falling_segment_time};
-use crate::exact::toi::{
+use crate::base::grid::NONE;
+use crate::collision::fall::{exit_time, falling_pair_time, falling_segment_time};
+use crate::collision::toi::{
     growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact, wall_time_of_impact,
 };
-use crate::grid::NONE;
 
 impl EventEngine {
     /// The soonest collision of circle `i` with a circle in `cells` or a large circle that it
@@ -44,7 +44,7 @@ impl EventEngine {
 
     /// [`EventEngine::scan`] over a whole block of cells: for circles on straight lines with
     /// radii that do not grow, through the nearest image, where the processor has AVX2 and
-    /// [`crate::vector::allow`] lets it, four pairs at a time ([`super::batch`]; a few
+    /// [`crate::base::vector::allow`] lets it, four pairs at a time ([`super::batch`]; a few
     /// neighbours, as in the cells a crossing newly borders, are cheaper one by one).
     fn scan_block(&mut self, i: usize, cells: impl IntoIterator<Item = usize>) -> BestPair {
         #[cfg(target_arch = "x86_64")]
@@ -52,10 +52,10 @@ impl EventEngine {
             && self.gravity == DVec2::ZERO
             && !self.images_wrap
             && self.growth == 0.0
-            && crate::vector::avx2()
+            && crate::base::vector::avx2()
         {
             let mut batch = self.batch.take().unwrap_or_default();
-            // SAFETY: `crate::vector::avx2` says the processor has AVX2.
+            // SAFETY: `crate::base::vector::avx2` says the processor has AVX2.
             let best = unsafe { self.scan_straight(i, cells, &mut batch) };
             self.batch = Some(batch);
             return best;

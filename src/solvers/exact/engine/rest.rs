@@ -26,7 +26,7 @@
 use bevy::math::DVec2;
 
 use super::EventEngine;
-use crate::boundary::put_back_inside;
+use crate::step::boundary::put_back_inside;
 
 /// A bounce that would lift a circle less than this many of its radii is rest.
 pub const REST_HEIGHT: f64 = 1e-3;

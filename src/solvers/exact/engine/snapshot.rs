@@ -10,11 +10,11 @@ use serde::{Deserialize, Serialize};
 use super::events::{BestPair, Event, EventStats, Kind, Motion, NO_PAIR};
 use super::spin::{Roughness, Spins};
 use super::{EventEngine, Layout, cell_width, walls_inside};
-use crate::arena::Arena;
-use crate::circle::CircleState;
-use crate::exact::queue::EventQueue;
-use crate::grid::{CellMembers, NONE};
-use crate::segment::Segment;
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::grid::{CellMembers, NONE};
+use crate::base::segment::Segment;
+use crate::solvers::exact::queue::EventQueue;
 
 /// An [`EventEngine`]'s state between two events, as data ([`EventEngine::snapshot`],
 /// [`EventEngine::restore`]).

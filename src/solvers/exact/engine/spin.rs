@@ -8,9 +8,9 @@ use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::EventEngine;
-use crate::circle::inverse_inertia;
-use crate::components::Rotation;
-use crate::exact::rough::{RoughSide, apply_rough_impulse};
+use crate::base::circle::inverse_inertia;
+use crate::base::components::Rotation;
+use crate::collision::rough::{RoughSide, apply_rough_impulse};
 
 /// How rough hits are: the tangential restitution β of circle pairs and of walls (arena and
 /// segment walls), each from −1 (smooth: no spin traded, as if there were no roughness) to +1

@@ -4,14 +4,14 @@
 
 use super::EventEngine;
 use super::large::{large_circles, reach};
-use crate::arena::Arena;
-use crate::boundary::put_back_inside;
-use crate::circle::CircleState;
-use crate::collide::contact::combine_restitution;
-use crate::collision_layers::{CollisionLayers, can_meet};
-use crate::grid::Grid;
-use crate::hits::{ArenaWall, Wall, WallHit};
-use crate::segment::{Segment, SegmentCells};
+use crate::base::arena::Arena;
+use crate::base::circle::CircleState;
+use crate::base::collision_layers::{CollisionLayers, can_meet};
+use crate::base::grid::Grid;
+use crate::base::hits::{ArenaWall, Wall, WallHit};
+use crate::base::segment::{Segment, SegmentCells};
+use crate::collision::contact::combine_restitution;
+use crate::step::boundary::put_back_inside;
 
 impl EventEngine {
     pub(super) fn hit_wall(&mut self, i: usize, axis: usize) {
@@ -262,7 +262,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::arena::Boundary;
+    use crate::base::arena::Boundary;
 
     /// A gas of `n` circles of radius `r` on a jittered lattice, with pseudo-random velocities.
     fn gas(n: usize, r: f64, arena: &Arena) -> Vec<CircleState> {

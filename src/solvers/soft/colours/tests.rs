@@ -5,9 +5,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
-use crate::grid::NONE;
-use crate::soft::bodies::Softness;
-use crate::soft::contacts::Partner;
+use crate::base::grid::NONE;
+use crate::solvers::soft::bodies::Softness;
+use crate::solvers::soft::contacts::Partner;
 
 /// `n` contacts among `circles` circles (some immovable), some touching, some open, with
 /// impulses, velocities and positions at random.

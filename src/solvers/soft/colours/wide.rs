@@ -13,7 +13,7 @@ use std::arch::x86_64::{
 use bevy::math::DVec2;
 
 use super::{Colours, Group, LANES, Pass, immovable_work};
-use crate::soft::stats::Work;
+use crate::solvers::soft::stats::Work;
 
 /// [`super::passes`] for a processor with AVX2.
 #[target_feature(enable = "avx2")]

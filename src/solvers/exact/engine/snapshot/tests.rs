@@ -3,7 +3,7 @@
 use bevy::math::DVec2;
 
 use super::*;
-use crate::arena::Boundary;
+use crate::base::arena::Boundary;
 
 /// [`EventEngine::restore`] of an elastic engine without gravity or segment walls, with this
 /// roughness and whether its circles collide.
