@@ -112,8 +112,9 @@
 //! - [`game`]: the plugin group [`CirclesPlugins`], spawning, sensors, spatial queries, each
 //!   circle's `Transform` following its position, and the diagnostics (energy, momentum,
 //!   pressure);
-//! - [`tools`]: scene and particle files, the headless app and the one stepping loop,
-//!   checkpoints, the accuracy study and the equation of state;
+//! - [`tools`] (feature `tools`, which `cli` and `render` bring): scene and particle files,
+//!   the headless app and the one stepping loop, checkpoints, the accuracy study and the
+//!   equation of state, files in and out;
 //! - [`render`] (feature `render`): the window, sprites, HUD, keys and the live panel;
 //! - [`cli`] (feature `cli`): the work behind each `moving_circles` command.
 //!
@@ -145,6 +146,7 @@ pub mod game;
 pub mod render;
 pub mod solvers;
 pub mod step;
+#[cfg(feature = "tools")]
 pub mod tools;
 
 pub use game::plugins::CirclesPlugins;
@@ -185,6 +187,7 @@ pub mod prelude {
         CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals,
     };
     pub use crate::step::sleep::{SleepPlugin, Sleeping};
+    #[cfg(feature = "tools")]
     pub use crate::tools::scene::Scene;
 }
 

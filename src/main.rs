@@ -10,7 +10,7 @@ use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
 use moving_circles::base::arena::Boundary;
 use moving_circles::base::config::{DT_RANGE, Placement, Solver};
-use moving_circles::base::io::printable;
+use moving_circles::base::error::printable;
 use moving_circles::cli;
 use moving_circles::cli::run::{Input, Length, RunOptions, SolverChoice};
 use moving_circles::cli::run::{MAX_STEPS, MAX_THREADS};

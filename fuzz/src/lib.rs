@@ -18,7 +18,7 @@ use moving_circles::base::components::Inertia;
 use moving_circles::base::config::{CirclesConfig, Effects, MAX_CIRCLES, Solver};
 use moving_circles::base::error::InputError;
 use moving_circles::solvers::exact::{EXACT_EVENTS_PER_CIRCLE, EventBudget, SWEPT_EVENTS_PER_CIRCLE};
-use moving_circles::base::io::{MAX_SCENE_BYTES, read_limited};
+use moving_circles::tools::io::{MAX_SCENE_BYTES, read_limited};
 use moving_circles::tools::run::{Report, advance, headless_app_with, out_of_range, run_steps};
 use moving_circles::tools::scene::check::{check_circle, first_overlap};
 use moving_circles::tools::scene::{Scene, particles as particle_file};

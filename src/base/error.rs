@@ -1,10 +1,10 @@
 //! The two error types of bad input: [`FieldError`], a configuration value out of range (which
 //! field, what is wrong), and [`InputError`], a problem in an input file located as precisely as
-//! the file allows (its origin, then the line or the field).
+//! the file allows (its origin, then the line or the field); and [`printable`], which every
+//! message quoting an input passes through.
 
+use std::borrow::Cow;
 use std::fmt;
-
-use crate::base::io::printable;
 
 /// A configuration value that cannot be used: the field (as a path like `spawn.radius`) and
 /// what is wrong with it.
@@ -113,3 +113,28 @@ impl fmt::Display for InputError {
 }
 
 impl std::error::Error for InputError {}
+
+/// `text` with every control character (ESC, BEL, CR, NUL, newline, …) written as a Rust escape
+/// (`\u{1b}`, `\r`, …), so that a file name or a word quoted from a file cannot move the cursor,
+/// retitle the terminal or forge a line of output. Other text, non-ASCII included, is kept.
+///
+/// ```
+/// use moving_circles::base::error::printable;
+///
+/// assert_eq!(printable("ok × 2"), "ok × 2");
+/// assert_eq!(printable("a\u{1b}]0;pwned\u{7}b\n"), "a\\u{1b}]0;pwned\\u{7}b\\n");
+/// ```
+pub fn printable(text: &str) -> Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    Cow::Owned(out)
+}

@@ -1,6 +1,6 @@
 //! What every layer shares: the arena, a circle's plain state and its components, segment
 //! walls, the grid, the configuration and its checks, the hit messages and counters, errors,
-//! value ranges, the vector-instruction switch and files in and out. Nothing here schedules a
+//! value ranges and the vector-instruction switch. Nothing here schedules a
 //! system or steps a circle.
 
 pub mod arena;
@@ -11,7 +11,6 @@ pub mod config;
 pub mod error;
 pub(crate) mod grid;
 pub mod hits;
-pub mod io;
 pub(crate) mod lattice;
 pub(crate) mod range;
 pub mod segment;

@@ -7,11 +7,11 @@ use std::path::Path;
 use anyhow::Context;
 
 use super::{prepare_out, write_results};
-use crate::base::io::{csv_text, say, write_atomically};
 use crate::tools::accuracy::piles::{pile_study, pile_table};
 use crate::tools::accuracy::plot::AccuracyFigure;
 use crate::tools::accuracy::report::{to_fronts, to_table};
 use crate::tools::accuracy::{Case, default_cases, pile_cases, pile_settings, settings, study};
+use crate::tools::io::{csv_text, say, write_atomically};
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`) and
 /// writes its CSV and plot into `out`.

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use crate::base::config::{CirclesConfig, Solver};
-use crate::base::io::printable;
+use crate::base::error::printable;
 use crate::render::{self, NO_WINDOW_HINT};
 use crate::tools::scene::{Scene, classic};
 

@@ -4,9 +4,9 @@
 use std::path::Path;
 
 use super::{prepare_out, write_results};
-use crate::base::io::say;
 use crate::tools::eos::plot::EosFigure;
 use crate::tools::eos::{EosOptions, EosPoint, measure};
+use crate::tools::io::say;
 
 /// Measures every area fraction of `options` and writes the results into `out`.
 pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {

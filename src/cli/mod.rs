@@ -11,8 +11,8 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use crate::base::io::{check_output_path, csv_text, say, write_atomically};
 use crate::tools::figure::{Figure, png, svg};
+use crate::tools::io::{check_output_path, csv_text, say, write_atomically};
 
 pub mod accuracy;
 #[cfg(feature = "render")]

@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use crate::base::config::Solver;
-use crate::base::io::say;
 use crate::step::schedule::scheduled_systems;
+use crate::tools::io::say;
 use crate::tools::run::headless_app;
 use crate::tools::scene::Scene;
 

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
-use crate::base::io::write_atomically;
+use crate::tools::io::write_atomically;
 
 /// Takes one screenshot after `frames` frames, then exits (with an error code if saving failed).
 #[derive(Clone, Debug)]

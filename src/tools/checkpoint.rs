@@ -3,7 +3,7 @@
 //! its pending events, and what code gave circles of their own — so that `run --resume` goes
 //! on bit for bit as the run would have (a game whose circles gained components goes on from
 //! the same state, its circles perhaps in another query order: see `own`).
-//! Written by `run --checkpoint` through [`write_atomically`](crate::base::io::write_atomically) in
+//! Written by `run --checkpoint` through [`write_atomically`](crate::tools::io::write_atomically) in
 //! a compact binary form (postcard) that ends in a checksum (`bytes`); read back with a size
 //! limit, the checksum and every value checked, so a damaged or forged file is an error naming
 //! the file, never a panic.

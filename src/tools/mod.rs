@@ -7,5 +7,6 @@ pub mod checkpoint;
 pub mod eos;
 #[cfg(feature = "cli")]
 pub(crate) mod figure;
+pub mod io;
 pub mod run;
 pub mod scene;

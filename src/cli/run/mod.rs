@@ -16,9 +16,9 @@ use bevy::prelude::App;
 
 use crate::base::circle::snapshot;
 use crate::base::config::Solver;
-use crate::base::io::{self, say};
 use crate::step::schedule::{StepTotals, StopRequest};
 use crate::tools::checkpoint::Checkpoint;
+use crate::tools::io::{self, say};
 use crate::tools::run::{Progress, Report, advance, default_sampling, out_of_range, sample_end};
 use crate::tools::scene::particles;
 pub use options::{Finished, Input, Length, MAX_STEPS, MAX_THREADS, RunOptions, SolverChoice};

@@ -8,10 +8,10 @@ use bevy::prelude::App;
 use super::options::{Input, Length, MAX_STEPS, RunOptions, SolverChoice};
 use crate::base::config::{CirclesConfig, Placement, Solver};
 use crate::base::error::InputError;
-use crate::base::io::{check_output_path, same_output};
 use crate::game::spawn::SpawnReport;
 use crate::step::schedule::StopRequest;
 use crate::tools::accuracy::auto::choose_solver;
+use crate::tools::io::{check_output_path, same_output};
 use crate::tools::run::headless_app_with;
 use crate::tools::scene::{Scene, particles};
 

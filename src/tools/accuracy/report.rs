@@ -1,5 +1,5 @@
 //! The study's results as text: the fixed-width table the command prints and the Pareto fronts
-//! (the CSV, one column per [`Row`] field, is written by [`crate::base::io::csv_text`]).
+//! (the CSV, one column per [`Row`] field, is written by [`crate::tools::io::csv_text`]).
 
 use super::front::{MEASURES, Panel, of_scene, scenes};
 use super::measure::Row;
@@ -71,7 +71,7 @@ pub fn to_fronts(rows: &[Row]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::base::io::csv_text;
+    use crate::tools::io::csv_text;
 
     #[test]
     fn the_csv_has_one_column_per_field_and_empty_cells_for_missing_values() {

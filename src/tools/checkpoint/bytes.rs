@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::{Checkpoint, MAX_CHECKPOINT_BYTES};
 use crate::base::error::InputError;
-use crate::base::io::read_bytes_limited;
+use crate::tools::io::read_bytes_limited;
 
 /// The first field of every checkpoint: what it is and the layout's version.
 pub(super) const FORMAT: &str = "moving_circles checkpoint 10";
@@ -25,7 +25,7 @@ fn check_format(bytes: &[u8], origin: &str) -> Result<(), InputError> {
             origin,
             format!(
                 "written by another version ({}), this one reads `{FORMAT}`",
-                crate::base::io::printable(other)
+                crate::base::error::printable(other)
             ),
         )),
         _ => Err(not_one()),

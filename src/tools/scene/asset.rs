@@ -14,10 +14,11 @@ use super::schema::Scene;
 use crate::base::arena::Arena;
 use crate::base::config::{CirclesConfig, DropConfig, Effects, Solver, SpawnConfig};
 use crate::base::error::InputError;
-use crate::base::io::{MAX_SCENE_BYTES, printable, read_limited};
+use crate::base::error::printable;
 use crate::base::segment::Segments;
 use crate::game::spawn::{FixedCircles, Respawn};
 use crate::step::schedule::allow_long_steps;
+use crate::tools::io::{MAX_SCENE_BYTES, read_limited};
 
 /// A scene file, checked and turned into a configuration.
 #[derive(Asset, TypePath, Clone, Debug)]

@@ -16,11 +16,11 @@ use crate::base::circle::{CircleState, discs};
 use crate::base::components::Tint;
 use crate::base::config::{CirclesConfig, MIN_RADIUS_FRACTION, SpawnConfig, min_radius};
 use crate::base::error::{FieldError, InputError};
-use crate::base::io::{MAX_SCENE_BYTES, read_limited};
 use crate::base::range::{MAX_MAGNITUDE, check_magnitude, check_mass, check_vector};
 use crate::base::segment::{MAX_SEGMENTS, SegmentCells, Segments, check_end};
 use crate::collision::broad_phase::visit_overlapping_pairs;
 use crate::solvers::discrete::pass::separate_overlaps;
+use crate::tools::io::{MAX_SCENE_BYTES, read_limited};
 
 impl Scene {
     /// Reads and checks a scene file into a configuration.

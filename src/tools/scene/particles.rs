@@ -14,7 +14,7 @@ use crate::base::arena::{Arena, Boundary};
 use crate::base::circle::CircleState;
 use crate::base::config::{CirclesConfig, MAX_CIRCLES, SpawnConfig};
 use crate::base::error::InputError;
-use crate::base::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE, Lines};
+use crate::tools::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE, Lines};
 
 /// Most bytes a particle file may have: a dump of the most circles an input may ask for, with
 /// every number written to full precision, fits.
@@ -27,7 +27,7 @@ pub fn parse(text: &str, origin: &str, boundary: Boundary) -> Result<Vec<CircleS
 }
 
 /// [`parse`] reading line by line from `reader`, at most [`MAX_PARTICLE_BYTES`] and lines of at
-/// most [`MAX_LINE_BYTES`](crate::base::io::MAX_LINE_BYTES): memory grows with the circles read,
+/// most [`MAX_LINE_BYTES`](crate::tools::io::MAX_LINE_BYTES): memory grows with the circles read,
 /// never with what the header claims or with a line that never ends. Before each line it asks
 /// `stop` whether to give up (a signal: an endless stream of blank lines must not keep it).
 pub fn parse_from(

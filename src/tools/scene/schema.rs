@@ -9,7 +9,7 @@ use serde::Deserialize;
 use crate::base::arena::Boundary;
 use crate::base::config::{DropConfig, Effects, MassModel, SoftConfig, Solver, SpawnConfig};
 use crate::base::error::InputError;
-use crate::base::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE};
+use crate::tools::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE};
 
 /// The arena as a scene file gives it.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]

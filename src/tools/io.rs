@@ -1,12 +1,13 @@
 //! Files in and out: [`write_atomically`] is how every output file of the project (reports,
 //! dumps, checkpoints, the accuracy CSV and plot, screenshots) reaches the disk,
 //! [`read_limited`] and [`Lines`] how input files are read without trusting their size, [`say`]
-//! how the commands print, and [`printable`] what keeps bytes from input files and names from
-//! reaching a terminal raw.
+//! how the commands print (through [`printable`](crate::base::error::printable), which keeps
+//! bytes from input files and names from reaching a terminal raw).
 
-use std::borrow::Cow;
 use std::io::{self, BufRead, Read, Write};
 use std::path::Path;
+
+use crate::base::error::printable;
 
 /// Most bytes a scene file may have (a scene with more circles belongs in a particle file).
 pub const MAX_SCENE_BYTES: u64 = 64 << 20;
@@ -103,7 +104,7 @@ impl<R: BufRead> Lines<R> {
 ///
 /// ```
 /// let path = std::env::temp_dir().join(format!("mc-doc-{}.txt", std::process::id()));
-/// moving_circles::base::io::write_atomically(&path, b"whole").unwrap();
+/// moving_circles::tools::io::write_atomically(&path, b"whole").unwrap();
 /// assert_eq!(std::fs::read(&path).unwrap(), b"whole");
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
@@ -295,31 +296,6 @@ fn kind_of(file_type: &std::fs::FileType) -> &'static str {
     } else {
         "not a regular file"
     }
-}
-
-/// `text` with every control character (ESC, BEL, CR, NUL, newline, …) written as a Rust escape
-/// (`\u{1b}`, `\r`, …), so that a file name or a word quoted from a file cannot move the cursor,
-/// retitle the terminal or forge a line of output. Other text, non-ASCII included, is kept.
-///
-/// ```
-/// use moving_circles::base::io::printable;
-///
-/// assert_eq!(printable("ok × 2"), "ok × 2");
-/// assert_eq!(printable("a\u{1b}]0;pwned\u{7}b\n"), "a\\u{1b}]0;pwned\\u{7}b\\n");
-/// ```
-pub fn printable(text: &str) -> Cow<'_, str> {
-    if !text.chars().any(char::is_control) {
-        return Cow::Borrowed(text);
-    }
-    let mut out = String::with_capacity(text.len() + 8);
-    for c in text.chars() {
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    Cow::Owned(out)
 }
 
 /// `rows` as CSV text, a header line then one line per row, the columns being the fields
