@@ -88,15 +88,6 @@ fn single_step(world: &mut World) {
     }
 }
 
-/// The solvers the app switches between (keys `1` to `5`, and the panel's buttons).
-pub const APP_SOLVERS: [Solver; 5] = [
-    Solver::Discrete,
-    Solver::Substeps(8),
-    Solver::Swept,
-    Solver::Exact,
-    Solver::Soft(4),
-];
-
 fn switch_solver(keys: Res<ButtonInput<KeyCode>>, mut solver: ResMut<Solver>) {
     let digits = [
         KeyCode::Digit1,
@@ -107,7 +98,7 @@ fn switch_solver(keys: Res<ButtonInput<KeyCode>>, mut solver: ResMut<Solver>) {
     ];
     let chosen = digits
         .into_iter()
-        .zip(APP_SOLVERS)
+        .zip(Solver::APP_CHOICES)
         .find(|(key, _)| keys.just_pressed(*key));
     if let Some((_, new)) = chosen {
         *solver = new;

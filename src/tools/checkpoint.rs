@@ -95,9 +95,10 @@ impl Checkpoint {
         };
         let budget_exhausted = state.budget_exhausted;
         let circles: Vec<CircleState> = with_entities.into_iter().map(|(_, c)| c).collect();
-        let contacts = match world.resource::<Solver>() {
-            Solver::Soft(_) => world.resource::<SoftState>().snapshot(&entities),
-            _ => None,
+        let contacts = if world.resource::<Solver>().is_soft() {
+            world.resource::<SoftState>().snapshot(&entities)
+        } else {
+            None
         };
         Self {
             format: FORMAT.to_owned(),
@@ -281,11 +282,11 @@ impl Checkpoint {
         }
         own::check(&self.own, self.circles.len())?;
         // No engine under `exact` is a build a signal stopped: the next step builds one.
-        if self.engine.is_some() && self.solver != Solver::Exact {
+        if self.engine.is_some() && !self.solver.keeps_engine() {
             return Err("the engine state does not match the solver".to_owned());
         }
         if let Some(contacts) = &self.contacts {
-            if !matches!(self.solver, Solver::Soft(_)) {
+            if !self.solver.is_soft() {
                 return Err("it holds soft contacts for another solver".to_owned());
             }
             contacts.check(&self.circles)?;

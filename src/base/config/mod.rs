@@ -84,6 +84,47 @@ impl Solver {
     pub fn is_continuous(self) -> bool {
         matches!(self, Self::Swept | Self::Exact)
     }
+
+    /// Whether this is the course's method, `discrete` or `substeps=N`: the step schedule run
+    /// once per substep.
+    pub fn is_discrete(self) -> bool {
+        matches!(self, Self::Discrete | Self::Substeps(_))
+    }
+
+    /// Whether this is the contact solver, `soft` at any substeps.
+    pub fn is_soft(self) -> bool {
+        matches!(self, Self::Soft(_))
+    }
+
+    /// Whether this solver keeps one event engine from step to step (`exact`; `swept` builds
+    /// one afresh each step).
+    pub fn keeps_engine(self) -> bool {
+        self == Self::Exact
+    }
+
+    /// Whether this solver models friction and rolling resistance (the contact solver); the
+    /// others ignore them.
+    pub fn models_friction(self) -> bool {
+        self.is_soft()
+    }
+
+    /// Whether this solver models rough hits (a tangential restitution above -1: the event
+    /// engine); the others ignore them.
+    pub fn models_rough_hits(self) -> bool {
+        self.is_continuous()
+    }
+
+    /// The solver every study measures the others against: `exact`.
+    pub const REFERENCE: Solver = Solver::Exact;
+
+    /// The solvers the app switches between (keys `1` to `5`, and the live panel's buttons).
+    pub const APP_CHOICES: [Solver; 5] = [
+        Solver::Discrete,
+        Solver::Substeps(8),
+        Solver::Swept,
+        Solver::Exact,
+        Solver::Soft(SOFT_SUBSTEPS),
+    ];
 }
 
 impl fmt::Display for Solver {

@@ -15,7 +15,6 @@ use anyhow::{Context, bail};
 use bevy::prelude::App;
 
 use crate::base::circle::snapshot;
-use crate::base::config::Solver;
 use crate::step::schedule::{StepTotals, StopRequest};
 use crate::tools::checkpoint::Checkpoint;
 use crate::tools::io::{self, say};
@@ -68,14 +67,13 @@ pub fn run(options: RunOptions) -> anyhow::Result<Finished> {
                 }
                 Err(e) => return Err(e),
             };
-            if config.effects.has_friction() && !matches!(config.solver, Solver::Soft(_)) {
+            if config.effects.has_friction() && !config.solver.models_friction() {
                 let solver = config.solver;
                 say(format_args!(
                     "note: friction acts under `soft` only; `{solver}` treats circles as smooth"
                 ));
             }
-            if config.effects.is_rough() && !matches!(config.solver, Solver::Swept | Solver::Exact)
-            {
+            if config.effects.is_rough() && !config.solver.models_rough_hits() {
                 let solver = config.solver;
                 say(format_args!(
                     "note: rough hits (tangential restitution) act under `swept` and `exact` only; \

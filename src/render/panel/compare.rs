@@ -107,7 +107,7 @@ pub fn start_comparison(world: &mut World) {
         .name("compare solvers".into())
         .spawn(move || {
             let dt = case.config.dt;
-            let reference = trace(&case, Solver::Exact, dt);
+            let reference = trace(&case, Solver::REFERENCE, dt);
             counter.fetch_add(1, Ordering::Relaxed);
             let rows = SOLVERS
                 .iter()

@@ -15,7 +15,7 @@ use super::controls::{Control, SPEED_RANGE};
 use super::live::{LiveHistory, LiveSample};
 use crate::base::config::{Effects, Solver};
 use crate::game::diagnostics::CircleDiagnostics;
-use crate::render::input::{APP_SOLVERS, MAX_COUNT};
+use crate::render::input::MAX_COUNT;
 use crate::tools::accuracy::Row;
 
 /// Slider values being dragged: a change that respawns is sent when the drag ends.
@@ -35,7 +35,7 @@ pub struct Settings<'w> {
 }
 
 /// Each solver's colour in the plots (as in the accuracy figure, lighter for exact on the dark
-/// panel), in the order of [`APP_SOLVERS`].
+/// panel), in the order of [`Solver::APP_CHOICES`].
 const COLOURS: [[u8; 3]; 4] = [
     [215, 48, 39],
     [35, 139, 69],
@@ -85,7 +85,7 @@ pub fn draw_panel(
 fn solver_buttons(ui: &mut egui::Ui, current: Solver, sent: &mut Vec<Control>) {
     ui.horizontal(|ui| {
         ui.label("solver");
-        for solver in APP_SOLVERS {
+        for solver in Solver::APP_CHOICES {
             if ui
                 .selectable_label(current == solver, solver.to_string())
                 .clicked()
@@ -237,7 +237,7 @@ fn tick(v: f64) -> String {
 }
 
 fn colour(solver: Solver) -> [u8; 3] {
-    APP_SOLVERS
+    Solver::APP_CHOICES
         .iter()
         .zip(COLOURS)
         .find(|(s, _)| std::mem::discriminant(*s) == std::mem::discriminant(&solver))

@@ -22,6 +22,7 @@ mod outside;
 pub mod pack;
 pub mod queue;
 
+use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
@@ -34,7 +35,9 @@ use crate::base::hits::{CircleHit, WallHit};
 use crate::base::segment::Segments;
 use crate::step::boundary::WallCollisions;
 use crate::step::integrate::turn_circles;
-use crate::step::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
+use crate::step::schedule::{
+    CircleSystems, ContinuousStep, SolverStep, StepDt, StopRequest, register_solver_step,
+};
 use crate::step::sleep::Sleeping;
 use keep::{EngineViews, Own, gather_into_engine};
 
@@ -91,7 +94,8 @@ impl EventBudget {
     }
 }
 
-/// Adds the `swept` / `exact` step to [`ContinuousStep`].
+/// The `swept` and `exact` solvers: their step in [`ContinuousStep`] (your forces in
+/// [`CircleSystems::Forces`], then [`CircleSystems::Continuous`]), run once a fixed step.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContinuousPlugin;
 
@@ -105,10 +109,22 @@ impl Plugin for ContinuousPlugin {
             .init_resource::<WallCollisions>()
             .add_message::<CircleHit>()
             .add_message::<WallHit>()
+            .configure_sets(
+                ContinuousStep,
+                (CircleSystems::Forces, CircleSystems::Continuous).chain(),
+            )
             .add_systems(
                 ContinuousStep,
                 continuous_step.in_set(CircleSystems::Continuous),
             );
+        register_solver_step(
+            app,
+            SolverStep {
+                solves: Solver::is_continuous,
+                schedule: ContinuousStep.intern(),
+                substepped: false,
+            },
+        );
     }
 }
 

@@ -21,6 +21,7 @@ pub mod sequential;
 pub mod solve;
 pub mod stats;
 
+use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -33,13 +34,14 @@ use crate::base::hits::PairCollisions;
 use crate::base::hits::{CircleHit, HitLog, WallHit};
 use crate::base::segment::{SegmentCells, Segments};
 use crate::step::boundary::WallCollisions;
-use crate::step::schedule::{CircleSystems, SoftStep, StepDt};
+use crate::step::schedule::{CircleSystems, SoftStep, SolverStep, StepDt, register_solver_step};
 pub use bodies::{Bodies, Softness};
 pub use cache::{CacheSnapshot, ContactCache};
 pub use solve::{SoftParams, SoftScratch, soft_step};
 pub use stats::SoftStats;
 
-/// Adds the `soft` step to [`SoftStep`].
+/// The contact solver `soft`: its step in [`SoftStep`] (your forces in
+/// [`CircleSystems::Forces`], then [`CircleSystems::Soft`]), run once a fixed step.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SoftPlugin;
 
@@ -53,7 +55,20 @@ impl Plugin for SoftPlugin {
             .register_type::<Friction>()
             .add_message::<CircleHit>()
             .add_message::<WallHit>()
+            .configure_sets(
+                SoftStep,
+                (CircleSystems::Forces, CircleSystems::Soft).chain(),
+            )
             .add_systems(SoftStep, step_soft.in_set(CircleSystems::Soft));
+        register_solver_step(
+            app,
+            SolverStep {
+                solves: Solver::is_soft,
+                schedule: SoftStep.intern(),
+                // The contact solver substeps inside its one system.
+                substepped: false,
+            },
+        );
     }
 }
 

@@ -28,10 +28,10 @@ pub fn choose_solver(config: &CirclesConfig, tolerance: f64) -> (Solver, Vec<Cal
         seconds,
         horizon: seconds,
     };
-    let reference = trace(&case, Solver::Exact, config.dt);
+    let reference = trace(&case, Solver::REFERENCE, config.dt);
     let mut measured: Vec<Calibration> = SOLVERS
         .iter()
-        .filter(|&&solver| solver != Solver::Exact)
+        .filter(|&&solver| solver != Solver::REFERENCE)
         .map(|&solver| {
             let row = compare(&case, &trace(&case, solver, config.dt), &reference);
             Calibration {
@@ -42,7 +42,7 @@ pub fn choose_solver(config: &CirclesConfig, tolerance: f64) -> (Solver, Vec<Cal
         })
         .collect();
     measured.push(Calibration {
-        solver: Solver::Exact,
+        solver: Solver::REFERENCE,
         error: 0.0,
         ms_per_step: reference.report.ms_per_step,
     });
@@ -50,6 +50,6 @@ pub fn choose_solver(config: &CirclesConfig, tolerance: f64) -> (Solver, Vec<Cal
         .iter()
         .filter(|c| c.error <= tolerance)
         .min_by(|a, b| a.ms_per_step.total_cmp(&b.ms_per_step))
-        .map_or(Solver::Exact, |c| c.solver);
+        .map_or(Solver::REFERENCE, |c| c.solver);
     (choice, measured)
 }

@@ -92,7 +92,8 @@ impl<'a> Panel<'a> {
     /// Splits one scene's `rows` into the reference and the others' values of `measure`.
     pub fn new(rows: &[&'a Row], measure: &Measure) -> Self {
         let is_reference = |r: &Row| {
-            r.solver == Solver::Exact.to_string() && rate(r) == (1.0 / REFERENCE_DT).round() as u32
+            r.solver == Solver::REFERENCE.to_string()
+                && rate(r) == (1.0 / REFERENCE_DT).round() as u32
         };
         Panel {
             reference: rows.iter().copied().find(|r| is_reference(r)),

@@ -119,7 +119,7 @@ pub fn study(
     let mut rows = Vec::new();
     for case in cases {
         progress(case, None);
-        let reference = trace(case, Solver::Exact, REFERENCE_DT);
+        let reference = trace(case, Solver::REFERENCE, REFERENCE_DT);
         for &(solver, dt) in settings {
             progress(case, Some((solver, dt)));
             rows.push(compare(case, &trace(case, solver, dt), &reference));
