@@ -5,7 +5,7 @@
 //!
 //! # Getting started
 //!
-//! Add the plugin group to an app and give it a [`CirclesConfig`]: the
+//! Add the plugin group to an app and give it a [`CirclesConfig`](base::config::CirclesConfig): the
 //! arena, what to spawn, the solver and the effects. Everything a user needs is in the
 //! [`prelude`].
 //!
@@ -25,11 +25,11 @@
 //!     .run();
 //! ```
 //!
-//! Headless, [`run::headless_app`] builds the app the tests and the command line step: every
+//! Headless, [`tools::run::headless_app`] builds the app the tests and the command line step: every
 //! `update()` is exactly one fixed step. Circles are entities with a [`Position`], a
 //! [`Velocity`] and a [`Radius`] (which brings the rest); with
-//! [`Effects::hit_messages`](config::Effects::hit_messages) on, each hit is a
-//! [`CircleHit`](hits::CircleHit) or [`WallHit`](hits::WallHit) message:
+//! [`Effects::hit_messages`](base::config::Effects::hit_messages) on, each hit is a
+//! [`CircleHit`](base::hits::CircleHit) or [`WallHit`](base::hits::WallHit) message:
 //!
 //! ```
 //! use bevy::math::DVec2;
@@ -100,7 +100,7 @@
 //! Seven layers, each importing only from those below it (`docs/architecture.md` has the map,
 //! file by file):
 //! - [`base`]: what every layer shares: the arena, a circle's state and its components, segment
-//!   walls, the configuration ([`CirclesConfig`]) with the limits on every value, hit messages
+//!   walls, the configuration ([`CirclesConfig`](base::config::CirclesConfig)) with the limits on every value, hit messages
 //!   and counters, errors;
 //! - [`collision`]: the collision layer, free of the ECS: times of impact, roots, impulses
 //!   smooth and rough, the broad phase, pair lists, overlap measures;

@@ -3,7 +3,7 @@
 //! use the straight-line [`pair_time_of_impact`](super::toi::pair_time_of_impact); what does
 //! not fall (walls, segment walls, immovable and sleeping circles) needs the parabola's roots:
 //! a quadratic against a line ([`exit_time`], [`falling_segment_time`]'s faces), a quartic
-//! against a point or a circle ([`falling_pair_time`]), both solved in [`super::roots`].
+//! against a point or a circle ([`falling_pair_time`]), both solved in `roots.rs`.
 
 use bevy::math::DVec2;
 

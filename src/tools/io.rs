@@ -1,7 +1,7 @@
 //! Files in and out: [`write_atomically`] is how every output file of the project (reports,
 //! dumps, checkpoints, the accuracy CSV and plot, screenshots) reaches the disk,
 //! [`read_limited`] and [`Lines`] how input files are read without trusting their size, [`say`]
-//! how the commands print (through [`printable`](crate::base::error::printable), which keeps
+//! how the commands print (through [`crate::base::error::printable`], which keeps
 //! bytes from input files and names from reaching a terminal raw).
 
 use std::io::{self, BufRead, Read, Write};

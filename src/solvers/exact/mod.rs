@@ -19,8 +19,8 @@
 pub mod engine;
 mod keep;
 mod outside;
-pub mod pack;
-pub mod queue;
+pub(crate) mod pack;
+pub(crate) mod queue;
 
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;

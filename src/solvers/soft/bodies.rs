@@ -94,11 +94,6 @@ impl Bodies {
         self.position.len()
     }
 
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.position.is_empty()
-    }
-
     /// Circle `i`'s own restitution, or `scene`'s if circles have none.
     #[inline]
     pub fn restitution_of(&self, i: usize, scene: f64) -> f64 {

@@ -53,11 +53,6 @@ pub struct ContactCache {
 }
 
 impl ContactCache {
-    /// Forgets every contact (after a respawn, say).
-    pub fn clear(&mut self) {
-        *self = Self::default();
-    }
-
     /// Gives every contact in `constraints` the impulse it ended last step with, and whether
     /// it pushed then (and its row in `rows`, if it has friction, the friction and rolling
     /// impulses it ended with). `ids` are the circles' identities now. A step calls it for its
@@ -285,8 +280,9 @@ struct CachedContact {
     rolling: f64,
 }
 
-/// [`ContactCache`] as plain data for a checkpoint: how many contacts each circle has (as
-/// their first circle), and each contact's partner, impulses and whether it pushed.
+/// The contacts kept for warm starting (`ContactCache`) as plain data for a checkpoint: how
+/// many contacts each circle has (as their first circle), and each contact's partner, impulses
+/// and whether it pushed.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CacheSnapshot {
     counts: Vec<u32>,

@@ -1,25 +1,25 @@
 //! The contact solver for games and piles, `soft` (`soft=N` for `N` substeps, 4 by default):
 //! Box2D v3's soft step for circles. Where `discrete` resolves each overlap once, after the
-//! fact, `soft` keeps every contact that may close during the step ([`contacts`]: speculative,
+//! fact, `soft` keeps every contact that may close during the step (`contacts.rs`: speculative,
 //! so a circle at game speed does not tunnel), makes each a damped spring stiff enough to hold
 //! a stack ([`Softness`]), starts each from last step's impulse (warm starting), and solves
 //! them all `N` times per step, relaxing after each substep and bouncing once at the end above
-//! a restitution threshold ([`solve`]). Tuned by [`SoftConfig`].
+//! a restitution threshold (`solve.rs`). Tuned by [`SoftConfig`].
 //!
 //! [`SoftPlugin`] adds one system to [`SoftStep`]: gather the circles, step the kernel
-//! ([`soft_step`]), write back what changed. It integrates gravity and drag itself in every
+//! (`soft_step`), write back what changed. It integrates gravity and drag itself in every
 //! substep, and handles the arena's walls, segment walls and collisions, so the effect plugins
 //! add nothing to this schedule: what a scene calls for is what the kernel is told to do.
 
-pub mod bodies;
-pub mod cache;
-pub mod colours;
-pub mod contacts;
-pub mod friction;
+pub(crate) mod bodies;
+pub(crate) mod cache;
+pub(crate) mod colours;
+pub(crate) mod contacts;
+pub(crate) mod friction;
 mod rules;
-pub mod sequential;
-pub mod solve;
-pub mod stats;
+pub(crate) mod sequential;
+pub(crate) mod solve;
+pub(crate) mod stats;
 
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
@@ -35,10 +35,12 @@ use crate::base::hits::{CircleHit, HitLog, WallHit};
 use crate::base::segment::{SegmentCells, Segments};
 use crate::step::boundary::WallCollisions;
 use crate::step::schedule::{CircleSystems, SoftStep, SolverStep, StepDt, register_solver_step};
-pub use bodies::{Bodies, Softness};
-pub use cache::{CacheSnapshot, ContactCache};
-pub use solve::{SoftParams, SoftScratch, soft_step};
-pub use stats::SoftStats;
+pub(crate) use bodies::Bodies;
+pub use bodies::Softness;
+pub use cache::CacheSnapshot;
+pub(crate) use cache::ContactCache;
+pub(crate) use solve::{SoftParams, SoftScratch, soft_step};
+pub(crate) use stats::SoftStats;
 
 /// The contact solver `soft`: its step in [`SoftStep`] (your forces in
 /// [`CircleSystems::Forces`], then [`CircleSystems::Soft`]), run once a fixed step.

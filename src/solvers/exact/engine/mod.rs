@@ -2,7 +2,7 @@
 //! gravity), and events (pair collisions, wall hits, segment wall hits, cell crossings) are
 //! processed in time order.
 //!
-//! Each circle has exactly one pending event, its soonest, held in an indexed [`EventQueue`].
+//! Each circle has exactly one pending event, its soonest, held in an indexed `EventQueue` (`queue.rs`).
 //! A pair event remembers its partner's collision counter; if the partner has collided since,
 //! the event is stale, and since nothing can have happened to the owner before it, the owner is
 //! simply predicted again from that moment (`predict`).
