@@ -14,7 +14,6 @@
 
 use std::time::Duration;
 
-use bevy::ecs::intern::Interned;
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
@@ -172,7 +171,28 @@ impl Plugin for StepPlugin {
             .init_resource::<StepDt>()
             .init_resource::<SubstepStart>()
             .init_resource::<StepTotals>()
-            .init_resource::<SolverSteps>()
+            .init_schedule(CircleStep)
+            .init_schedule(ContinuousStep)
+            .init_schedule(SoftStep)
+            // The step's systems run in a chain, so a multi-threaded executor would only add
+            // thread wake-ups to every substep.
+            .edit_schedule(CircleStep, |s| {
+                s.set_executor(SingleThreadedExecutor::new());
+            })
+            .edit_schedule(ContinuousStep, |s| {
+                s.set_executor(SingleThreadedExecutor::new());
+            })
+            .edit_schedule(SoftStep, |s| {
+                s.set_executor(SingleThreadedExecutor::new());
+            })
+            .configure_sets(
+                ContinuousStep,
+                (CircleSystems::Forces, CircleSystems::Continuous).chain(),
+            )
+            .configure_sets(
+                SoftStep,
+                (CircleSystems::Forces, CircleSystems::Soft).chain(),
+            )
             .configure_sets(
                 CircleStep,
                 (
@@ -205,16 +225,6 @@ impl Plugin for StepPlugin {
                 ),
             )
             .add_systems(FixedUpdate, run_circle_step.in_set(CircleSystems::Step));
-        // The course's method is the step's own: forces, integration, walls and collisions are
-        // the shared plugins' systems in this schedule, run once per substep.
-        register_solver_step(
-            app,
-            SolverStep {
-                solves: Solver::is_discrete,
-                schedule: CircleStep.intern(),
-                substepped: true,
-            },
-        );
     }
 }
 
@@ -228,60 +238,29 @@ pub(crate) fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Vi
     }
 }
 
-/// How a solver advances one fixed step: the schedule its plugin registers
-/// ([`register_solver_step`]), run once per substep with that part of the step (the discrete
-/// solvers), or once with the whole step (a solver that substeps inside, or not at all).
-#[derive(Clone, Copy, Debug)]
-pub struct SolverStep {
-    /// Which solvers this is the step of.
-    pub solves: fn(Solver) -> bool,
-    /// The schedule of one (sub)step.
-    pub schedule: Interned<dyn ScheduleLabel>,
-    /// Whether the schedule runs `solver.substeps()` times with `dt / substeps`.
-    pub substepped: bool,
-}
-
-/// The step of every solver whose plugin is in the app, in the order registered.
-#[derive(Resource, Clone, Debug, Default)]
-pub struct SolverSteps(Vec<SolverStep>);
-
-impl SolverSteps {
-    /// The step that advances `solver`, if its plugin registered one.
-    pub fn of(&self, solver: Solver) -> Option<SolverStep> {
-        self.0.iter().copied().find(|step| (step.solves)(solver))
-    }
-}
-
-/// Makes `step` the way its solvers advance a fixed step: its schedule is created (run on one
-/// thread: a step's systems run in a chain, so more threads would only add wake-ups) and run
-/// by [`CircleSystems::Step`] whenever the [`Solver`] is one of its own. A solver's plugin calls
-/// this once; adding a solver needs nothing else from the step.
-pub fn register_solver_step(app: &mut App, step: SolverStep) {
-    app.init_resource::<SolverSteps>()
-        .init_schedule(step.schedule)
-        .edit_schedule(step.schedule, |s| {
-            s.set_executor(SingleThreadedExecutor::new());
-        });
-    app.world_mut().resource_mut::<SolverSteps>().0.push(step);
-}
-
-/// Advances one fixed step with the current [`Solver`]: runs its registered step's schedule
-/// once per substep with the substep's `dt`, or once with the whole step. A solver whose plugin
-/// is not in the app moves nothing; its steps are still counted.
+/// Advances one fixed step with the current [`Solver`]: runs [`CircleStep`] once per substep
+/// with the substep's `dt`, or [`ContinuousStep`] or [`SoftStep`] once.
 pub(crate) fn run_circle_step(world: &mut World) {
     let solver = *world.resource::<Solver>();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
-    if let Some(step) = world.resource::<SolverSteps>().of(solver) {
-        let runs = if step.substepped {
-            solver.substeps()
-        } else {
-            1
-        };
-        let part = dt / f64::from(runs);
-        world.resource_mut::<StepDt>().0 = part;
-        for k in 0..runs {
-            world.resource_mut::<SubstepStart>().0 = f64::from(k) * part;
-            world.run_schedule(step.schedule);
+    let whole_step = if solver.is_continuous() {
+        Some(ContinuousStep.intern())
+    } else if solver.is_soft() {
+        Some(SoftStep.intern())
+    } else {
+        None
+    };
+    if let Some(schedule) = whole_step {
+        world.resource_mut::<StepDt>().0 = dt;
+        world.resource_mut::<SubstepStart>().0 = 0.0;
+        world.run_schedule(schedule);
+    } else {
+        let substeps = solver.substeps();
+        let sub_dt = dt / f64::from(substeps);
+        world.resource_mut::<StepDt>().0 = sub_dt;
+        for k in 0..substeps {
+            world.resource_mut::<SubstepStart>().0 = f64::from(k) * sub_dt;
+            world.run_schedule(CircleStep);
         }
     }
     let mut totals = world.resource_mut::<StepTotals>();

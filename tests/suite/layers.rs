@@ -1,7 +1,8 @@
 //! The structure rules of `src/`, checked on the source text: every import points down the
 //! layers (`base`, `collision`, `step`, `solvers`, `game`, `tools`, `render`, `cli`, and
-//! `lib.rs`, which declares them) or stays within its layer, no solver's folder imports another's, no two
-//! files import each other through any chain, and no file is over 450 lines.
+//! `lib.rs`, which declares them) or stays within its layer, no solver's folder imports
+//! another's, no two files or folders import each other through any chain, and no file is over
+//! 450 lines.
 //!
 //! An import is any `crate::…` or `super::…` path in code (comments are skipped), including
 //! each branch of a `use` tree; it points at the deepest module file the path names.
@@ -319,6 +320,40 @@ fn every_import_points_down_the_layers_and_no_solver_imports_another() {
     let graph = import_graph(&src);
     let wrong = imports_against_the_layers(&graph);
     assert!(wrong.is_empty(), "imports against the layers: {wrong:#?}");
+}
+
+/// The folder-level graph: an edge from a folder to another when a file directly in the first
+/// imports a file directly in the second.
+fn folder_graph(
+    graph: &BTreeMap<PathBuf, BTreeSet<PathBuf>>,
+) -> BTreeMap<PathBuf, BTreeSet<PathBuf>> {
+    let folder = |f: &Path| f.parent().unwrap().to_path_buf();
+    let mut folders: BTreeMap<PathBuf, BTreeSet<PathBuf>> = BTreeMap::new();
+    for (from, targets) in graph {
+        folders.entry(folder(from)).or_default();
+        for to in targets {
+            folders.entry(folder(to)).or_default();
+            if folder(from) != folder(to) {
+                folders.get_mut(&folder(from)).unwrap().insert(folder(to));
+            }
+        }
+    }
+    folders
+}
+
+#[test]
+fn no_folder_imports_itself_through_other_folders() {
+    let graph = import_graph(&src());
+    let folders = folder_graph(&graph);
+    // The reader sees the folders: the solvers' folders import the collision layer's.
+    assert!(folders[&src().join("solvers/soft")].contains(&src().join("collision")));
+    if let Some(cycle) = find_cycle(&folders) {
+        let names: Vec<String> = cycle
+            .iter()
+            .map(|f| f.strip_prefix(src()).unwrap().display().to_string())
+            .collect();
+        panic!("folder cycle: {}", names.join(" → "));
+    }
 }
 
 #[test]

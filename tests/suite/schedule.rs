@@ -134,56 +134,6 @@ fn a_part_can_be_disabled_like_any_bevy_plugin_group() {
 }
 
 #[test]
-fn every_solver_has_its_plugins_step_and_one_without_its_plugin_moves_nothing() {
-    use moving_circles::step::schedule::SolverSteps;
-    let app = moving_circles::tools::run::headless_app(CirclesConfig::default());
-    let steps = app.world().resource::<SolverSteps>();
-    for (solver, schedule, substepped) in [
-        ("discrete", "CircleStep", true),
-        ("substeps=3", "CircleStep", true),
-        ("swept", "ContinuousStep", false),
-        ("exact", "ContinuousStep", false),
-        ("soft", "SoftStep", false),
-        ("soft=2", "SoftStep", false),
-    ] {
-        let step = steps.of(solver.parse().unwrap()).expect(solver);
-        assert_eq!(format!("{:?}", step.schedule), schedule, "{solver}");
-        assert_eq!(step.substepped, substepped, "{solver}");
-    }
-    // Without the contact solver's plugin, `soft` has no step: time is counted, nothing moves.
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        CirclesPlugins::new(CirclesConfig {
-            solver: Solver::Soft(4),
-            ..default()
-        })
-        .build()
-        .disable::<SoftPlugin>(),
-    ));
-    app.finish();
-    app.cleanup();
-    app.update();
-    spawn_head_on(&mut app, 1.0, 1.0, 0.2);
-    let before = circles(&mut app);
-    let steps = app.world().resource::<StepTotals>().steps;
-    for _ in 0..10 {
-        app.world_mut().run_schedule(FixedUpdate);
-    }
-    assert_eq!(circles(&mut app), before);
-    assert_eq!(app.world().resource::<StepTotals>().steps, steps + 10);
-    // With it, the same circles move.
-    let mut app = moving_circles::tools::run::headless_app(CirclesConfig {
-        solver: Solver::Soft(4),
-        ..default()
-    });
-    spawn_head_on(&mut app, 1.0, 1.0, 0.2);
-    let before = circles(&mut app);
-    step(&mut app, 10);
-    assert_ne!(circles(&mut app), before);
-}
-
-#[test]
 fn diagnostics_are_measured_every_step_except_while_a_headless_run_steps() {
     use moving_circles::tools::run::run_steps;
     let mut app = moving_circles::tools::run::headless_app(CirclesConfig {

@@ -22,7 +22,6 @@ mod outside;
 pub(crate) mod pack;
 pub(crate) mod queue;
 
-use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
@@ -35,9 +34,7 @@ use crate::base::hits::{CircleHit, WallHit};
 use crate::base::segment::Segments;
 use crate::step::boundary::WallCollisions;
 use crate::step::integrate::turn_circles;
-use crate::step::schedule::{
-    CircleSystems, ContinuousStep, SolverStep, StepDt, StopRequest, register_solver_step,
-};
+use crate::step::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
 use crate::step::sleep::Sleeping;
 use keep::{EngineViews, Own, gather_into_engine};
 
@@ -109,22 +106,10 @@ impl Plugin for ContinuousPlugin {
             .init_resource::<WallCollisions>()
             .add_message::<CircleHit>()
             .add_message::<WallHit>()
-            .configure_sets(
-                ContinuousStep,
-                (CircleSystems::Forces, CircleSystems::Continuous).chain(),
-            )
             .add_systems(
                 ContinuousStep,
                 continuous_step.in_set(CircleSystems::Continuous),
             );
-        register_solver_step(
-            app,
-            SolverStep {
-                solves: Solver::is_continuous,
-                schedule: ContinuousStep.intern(),
-                substepped: false,
-            },
-        );
     }
 }
 

@@ -21,7 +21,6 @@ pub(crate) mod sequential;
 pub(crate) mod solve;
 pub(crate) mod stats;
 
-use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -34,7 +33,7 @@ use crate::base::hits::PairCollisions;
 use crate::base::hits::{CircleHit, HitLog, WallHit};
 use crate::base::segment::{SegmentCells, Segments};
 use crate::step::boundary::WallCollisions;
-use crate::step::schedule::{CircleSystems, SoftStep, SolverStep, StepDt, register_solver_step};
+use crate::step::schedule::{CircleSystems, SoftStep, StepDt};
 pub(crate) use bodies::Bodies;
 pub use bodies::Softness;
 pub use cache::CacheSnapshot;
@@ -57,20 +56,7 @@ impl Plugin for SoftPlugin {
             .register_type::<Friction>()
             .add_message::<CircleHit>()
             .add_message::<WallHit>()
-            .configure_sets(
-                SoftStep,
-                (CircleSystems::Forces, CircleSystems::Soft).chain(),
-            )
             .add_systems(SoftStep, step_soft.in_set(CircleSystems::Soft));
-        register_solver_step(
-            app,
-            SolverStep {
-                solves: Solver::is_soft,
-                schedule: SoftStep.intern(),
-                // The contact solver substeps inside its one system.
-                substepped: false,
-            },
-        );
     }
 }
 
