@@ -20,7 +20,6 @@ pub mod engine;
 mod keep;
 mod outside;
 pub(crate) mod pack;
-pub(crate) mod queue;
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;

@@ -6,13 +6,13 @@ use bevy::math::DVec2;
 
 use super::EventEngine;
 use super::events::{Event, EventStats, Kind, Motion, NO_PAIR, Rest};
+use super::queue::EventQueue;
 use super::walls::{Layout, cell_width, walls_inside};
 use crate::base::arena::Arena;
 use crate::base::circle::CircleState;
 use crate::base::collision_layers::CollisionLayers;
 use crate::base::grid::{CellMembers, NONE};
 use crate::base::segment::Segment;
-use crate::solvers::exact::queue::EventQueue;
 
 /// Predictions between two looks at [`EventEngine::build_until`]'s stop request: a few
 /// milliseconds of work.

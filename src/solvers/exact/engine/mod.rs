@@ -29,6 +29,7 @@ mod large;
 mod motion;
 mod pairs;
 mod predict;
+mod queue;
 mod rest;
 mod snapshot;
 mod spin;
@@ -44,13 +45,13 @@ use walls::{Layout, cell_width, walls_inside};
 
 use bevy::math::DVec2;
 
-use super::queue::EventQueue;
 use crate::base::arena::Arena;
 use crate::base::circle::CircleState;
 use crate::base::collision_layers::{CollisionLayers, can_meet, pair_meets};
 use crate::base::grid::{CellMembers, Grid};
 use crate::base::hits::HitLog;
 use crate::base::segment::{Segment, SegmentCells};
+use queue::EventQueue;
 
 /// Events between two looks at [`EventEngine::advance_until_stopped`]'s stop request: about a
 /// millisecond of events, so a stop is seen at once and asking costs nothing.

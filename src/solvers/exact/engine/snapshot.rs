@@ -8,13 +8,13 @@ use bevy::math::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::events::{BestPair, Event, EventStats, Kind, Motion, NO_PAIR};
+use super::queue::EventQueue;
 use super::spin::{Roughness, Spins};
 use super::{EventEngine, Layout, cell_width, walls_inside};
 use crate::base::arena::Arena;
 use crate::base::circle::CircleState;
 use crate::base::grid::{CellMembers, NONE};
 use crate::base::segment::Segment;
-use crate::solvers::exact::queue::EventQueue;
 
 /// An [`EventEngine`]'s state between two events, as data ([`EventEngine::snapshot`],
 /// [`EventEngine::restore`]).
