@@ -306,13 +306,17 @@ fn watch_signals() -> anyhow::Result<()> {
     use signal_hook::consts::{SIGINT, SIGTERM};
     let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
         .context("installing the signal handlers")?;
+    use std::io::Write;
     std::thread::Builder::new()
         .name("signals".into())
         .spawn(move || {
             let mut signals = signals.forever();
             if let Some(signal) = signals.next() {
                 let name = signal_hook::low_level::signal_name(signal).unwrap_or("a signal");
-                eprintln!(
+                // Not `eprintln!`, which panics on a closed standard error: this thread must
+                // live to hear the second signal.
+                let _ = writeln!(
+                    std::io::stderr(),
                     "moving_circles: {name}: finishing cleanly; a second signal ends the run at \
                      once, leaving old outputs in place"
                 );
