@@ -12,18 +12,20 @@
 use bevy::math::DVec2;
 use bevy::prelude::Entity;
 use moving_circles::base::arena::{Arena, Boundary};
-use moving_circles::tools::checkpoint::Checkpoint;
 use moving_circles::base::circle::{CircleState, inverse_inertia, snapshot_with_entities};
 use moving_circles::base::components::Inertia;
 use moving_circles::base::config::{CirclesConfig, Effects, MAX_CIRCLES, Solver};
 use moving_circles::base::error::InputError;
-use moving_circles::solvers::exact::{EXACT_EVENTS_PER_CIRCLE, EventBudget, SWEPT_EVENTS_PER_CIRCLE};
+use moving_circles::base::segment::{SegmentCells, Segments};
+use moving_circles::solvers::exact::{
+    EXACT_EVENTS_PER_CIRCLE, EventBudget, SWEPT_EVENTS_PER_CIRCLE,
+};
+use moving_circles::step::schedule::StepTotals;
+use moving_circles::tools::checkpoint::Checkpoint;
 use moving_circles::tools::io::{MAX_SCENE_BYTES, read_limited};
 use moving_circles::tools::run::{Report, advance, headless_app_with, out_of_range, run_steps};
 use moving_circles::tools::scene::check::{check_circle, first_overlap};
 use moving_circles::tools::scene::{Scene, particles as particle_file};
-use moving_circles::step::schedule::StepTotals;
-use moving_circles::base::segment::{SegmentCells, Segments};
 
 /// Most circles [`simulate`] runs: inputs asking for more are only read and checked. With
 /// [`SIMULATED_STEPS`] and [`FUZZ_BUDGET`] this bounds an execution: the slowest input costs
