@@ -5,7 +5,9 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::base::components::{AngularVelocity, Mass, Position, Radius, Rotation, Tint, Velocity};
+use crate::base::components::{
+    AngularVelocity, CircleSerial, Mass, Position, Radius, Rotation, Tint, Velocity,
+};
 
 /// The moment of inertia of a uniform disc of `mass` and `radius` about its centre: `m r² / 2`,
 /// what every circle turns with.
@@ -133,22 +135,26 @@ pub(crate) type Parts = (
     Option<&'static Rotation>,
 );
 
-/// Every circle in the world, in query order (the order they were spawned in).
+/// Every circle in the world, in serial order (the order they were spawned in, which is the
+/// order the solvers visit them in: [`CircleSerial`]).
 pub fn snapshot(world: &mut World) -> Vec<CircleState> {
-    world
-        .query::<Parts>()
-        .iter(world)
-        .map(from_components)
+    snapshot_with_entities(world)
+        .into_iter()
+        .map(|(_, c)| c)
         .collect()
 }
 
 /// [`snapshot`] with each circle's entity.
 pub fn snapshot_with_entities(world: &mut World) -> Vec<(Entity, CircleState)> {
-    world
-        .query::<(Entity, Parts)>()
+    let mut circles: Vec<(CircleSerial, Entity, CircleState)> = world
+        .query::<(Entity, &CircleSerial, Parts)>()
         .iter(world)
-        .map(|(e, parts)| (e, from_components(parts)))
-        .collect()
+        .map(|(e, &serial, parts)| (serial, e, from_components(parts)))
+        .collect();
+    if !circles.is_sorted_by_key(|c| c.0) {
+        circles.sort_unstable_by_key(|c| c.0);
+    }
+    circles.into_iter().map(|(_, e, c)| (e, c)).collect()
 }
 
 pub(crate) fn from_components(

@@ -1,11 +1,16 @@
 //! The components a circle is made of: `Position`, `Velocity`, `Radius`, `Mass`, `Tint`,
-//! `Sleep`, `Rotation` and `AngularVelocity`, and the optional `Restitution` and `Friction`.
+//! `Sleep`, `Rotation`, `AngularVelocity` and `CircleSerial`, and the optional `Restitution`
+//! and `Friction`.
 //!
 //! `Position` is deliberately not `Transform`: the simulation owns it, and the render side copies
 //! it into `Transform` only when rendering is on. Inserting a [`Radius`] is what makes an entity a
 //! circle; it brings the other components with it (`#[require]`), so
 //! `commands.spawn((Radius(0.5), Position(DVec2::ZERO)))` is a complete, resting, unit-mass circle.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use bevy::ecs::lifecycle::HookContext;
+use bevy::ecs::world::DeferredWorld;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
@@ -22,7 +27,16 @@ pub struct Velocity(pub DVec2);
 /// Radius of a circle. Must be finite and positive; inserting it makes the entity a circle.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Debug)]
-#[require(Position, Velocity, Mass, Tint, Sleep, Rotation, AngularVelocity)]
+#[require(
+    Position,
+    Velocity,
+    Mass,
+    Tint,
+    Sleep,
+    Rotation,
+    AngularVelocity,
+    CircleSerial
+)]
 pub struct Radius(pub f64);
 
 /// Mass of a circle.
@@ -185,19 +199,18 @@ pub struct Sleep {
 
 /// The circles as every solver's systems read and write them (the discrete contact pass, the
 /// wall bounce, the continuous step), in one query type so each sees them in the same order.
-pub type SolverCircles<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Entity,
-        &'static mut Position,
-        &'static mut Velocity,
-        &'static Radius,
-        &'static Mass,
-        Option<&'static Restitution>,
-        &'static Sleep,
-    ),
->;
+pub type SolverCircles<'w, 's> = Query<'w, 's, SolverData>;
+
+/// What [`SolverCircles`] fetches of each circle.
+pub type SolverData = (
+    Entity,
+    &'static mut Position,
+    &'static mut Velocity,
+    &'static Radius,
+    &'static Mass,
+    Option<&'static Restitution>,
+    &'static Sleep,
+);
 
 /// How circles turn, as the solvers read and write it, in a query of its own so that a step
 /// in which nothing turns pays nothing for it: each circle's angular velocity and rotation
@@ -215,6 +228,50 @@ pub type SpinCircles<'w, 's> = Query<
     ),
     With<Radius>,
 >;
+
+/// A circle's place in the order every solver visits circles: given when the circle is
+/// spawned, larger for every later circle, so the solvers see the circles in the order they
+/// were spawned whatever tables Bevy keeps them in and whatever entity ids they have. That is
+/// what makes a step's bits independent of the world's layout: a circle that gains or loses a
+/// component moves to another table, and a world rebuilt from a checkpoint or a rollback
+/// snapshot has new entities, yet each steps as the original.
+///
+/// Spawned without one (the default, [`CircleSerial::UNASSIGNED`]), a circle gets the next
+/// free serial; spawned with one (a restored world), it keeps it, and later circles get larger
+/// ones. Only the order of serials means anything: their values depend on what else the
+/// process spawned.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[reflect(Component, Default, Debug)]
+#[component(on_insert = give_serial)]
+pub struct CircleSerial(pub u64);
+
+impl CircleSerial {
+    /// The serial of a circle not yet given one.
+    pub const UNASSIGNED: CircleSerial = CircleSerial(u64::MAX);
+}
+
+impl Default for CircleSerial {
+    fn default() -> Self {
+        Self::UNASSIGNED
+    }
+}
+
+/// The next serial to give: one counter for the process, so serials grow in spawn order in
+/// every world (a world sees gaps where another world spawned).
+static NEXT_SERIAL: AtomicU64 = AtomicU64::new(0);
+
+/// Gives a circle inserted without a serial the next one, and keeps the counter above a
+/// serial given explicitly.
+fn give_serial(mut world: DeferredWorld, context: HookContext) {
+    let Some(mut serial) = world.get_mut::<CircleSerial>(context.entity) else {
+        return;
+    };
+    if *serial == CircleSerial::UNASSIGNED {
+        serial.0 = NEXT_SERIAL.fetch_add(1, Ordering::Relaxed);
+    } else {
+        NEXT_SERIAL.fetch_max(serial.0.saturating_add(1), Ordering::Relaxed);
+    }
+}
 
 impl From<DVec2> for Position {
     fn from(v: DVec2) -> Self {

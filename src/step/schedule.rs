@@ -16,10 +16,12 @@ use std::time::Duration;
 
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::schedule::SingleThreadedExecutor;
+use bevy::ecs::system::SystemState;
 use bevy::prelude::*;
 
 use crate::base::arena::Arena;
 use crate::base::config::{Effects, SoftConfig, Solver};
+use crate::base::order::{CircleOrder, SerialCircles};
 use crate::base::segment::Segments;
 use crate::step::effects::reconcile_effects;
 
@@ -171,6 +173,7 @@ impl Plugin for StepPlugin {
             .init_resource::<StepDt>()
             .init_resource::<SubstepStart>()
             .init_resource::<StepTotals>()
+            .init_resource::<CircleOrder>()
             .init_schedule(CircleStep)
             .init_schedule(ContinuousStep)
             .init_schedule(SoftStep)
@@ -238,9 +241,17 @@ pub(crate) fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Vi
     }
 }
 
-/// Advances one fixed step with the current [`Solver`]: runs [`CircleStep`] once per substep
-/// with the substep's `dt`, or [`ContinuousStep`] or [`SoftStep`] once.
-pub(crate) fn run_circle_step(world: &mut World) {
+/// Advances one fixed step with the current [`Solver`]: orders the circles by serial
+/// ([`CircleOrder`]), then runs [`CircleStep`] once per substep with the substep's `dt`, or
+/// [`ContinuousStep`] or [`SoftStep`] once.
+pub(crate) fn run_circle_step(
+    world: &mut World,
+    circles: &mut SystemState<SerialCircles<'static, 'static>>,
+) {
+    let mut order = std::mem::take(&mut *world.resource_mut::<CircleOrder>());
+    let circles = circles.get(world).expect("a query is always valid");
+    order.update(circles.iter().map(|(e, &serial)| (e, serial)));
+    *world.resource_mut::<CircleOrder>() = order;
     let solver = *world.resource::<Solver>();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
     let whole_step = if solver.is_continuous() {

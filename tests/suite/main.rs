@@ -8,6 +8,7 @@ mod accuracy;
 mod app_controls;
 mod bad_input;
 mod bodies;
+mod circle_order;
 mod cli;
 mod collision_layers;
 mod collisions;

@@ -18,6 +18,7 @@ use crate::base::components::{
     SpinCircles, Velocity,
 };
 use crate::base::config::{Effects, Solver};
+use crate::base::order::CircleOrder;
 use crate::base::segment::Segments;
 use crate::step::schedule::StopRequest;
 
@@ -26,16 +27,13 @@ use crate::step::schedule::StopRequest;
 /// collision does; a rebuild, what `N` of them do).
 const MOVED_FOR_REBUILD: usize = 4;
 
-/// The engine kept between `exact` steps, with the entities of its circles (in the order of
-/// [`SolverCircles`] when it was built) and, once a step needs it, each one's index.
+/// The engine kept between `exact` steps, with the entities of its circles (in serial order,
+/// [`CircleOrder`], when it was built) and, once a step needs it, each one's index.
 #[derive(Resource, Default)]
 pub struct EngineState {
     pub(super) engine: Option<EventEngine>,
     pub(super) entities: Vec<Entity>,
     pub(super) index: EntityHashMap<usize>,
-    /// Whether the last write-back found the circles in another order than `entities` (an
-    /// entity moved between archetypes), so the next step rebuilds.
-    pub(super) reordered: bool,
     /// Whether a stop request ended the last step early: its engine flew the circles to the
     /// step's end without predicting again ([`EventEngine::fly_unpredicted_to`]), so it is not
     /// kept and the next step, if any, rebuilds.
@@ -73,7 +71,6 @@ impl EngineState {
         let kept = self.setup == Some(setup)
             && setup.2 == Solver::Exact
             && self.segments == *segments
-            && !self.reordered
             && !self.stopped
             && engine.cells_sized_for_all()
             && circles.len() == self.entities.len()
@@ -155,7 +152,6 @@ impl EngineState {
     fn know(&mut self, entities: Vec<Entity>) {
         self.index.clear();
         self.entities = entities;
-        self.reordered = false;
         self.stopped = false;
     }
 }
@@ -235,7 +231,11 @@ pub(super) struct Own<'a> {
 /// a circle, and builds a fresh one otherwise. Says which in a debug log. A build that `stop`
 /// ends leaves no engine: the step then moves nothing and counts in `budget_exhausted`.
 pub(super) fn gather_into_engine(
-    (setup, stop): ((Solver, Arena, Effects, &Segments), Option<&StopRequest>),
+    (setup, order, stop): (
+        (Solver, Arena, Effects, &Segments),
+        &CircleOrder,
+        Option<&StopRequest>,
+    ),
     state: &mut EngineState,
     own: Own,
     circles: &mut ParamSet<EngineViews>,
@@ -257,7 +257,6 @@ pub(super) fn gather_into_engine(
         (Some(_), _) if kept && own.lost => {
             "a circle lost its restitution or moment of inertia, or its layers changed"
         }
-        (Some(_), _) if kept && state.reordered => "circles moved between archetypes",
         (Some(_), _) if kept && state.stopped => "a stop request ended the last step early",
         (Some(engine), _) if kept && state.setup == Some(key) && state.segments == *segments => {
             let mut changed: Vec<Entity> = circles.p1().iter().collect();
@@ -318,11 +317,6 @@ pub(super) fn gather_into_engine(
         state.setup = None;
         state.budget_exhausted += 1;
     };
-    let all = circles.p0();
-    let bodies: Vec<CircleState> = all
-        .iter()
-        .map(|(_, p, v, r, m, ..)| CircleState::new(p.0, v.0, r.0).with_mass(m.0))
-        .collect();
     // A sleeper your code set moving or turning since the last step wakes, as under the
     // time-stepped solvers (built asleep, it would lose the velocity).
     let rest_of = |sleep: &Sleep, moving: bool| match sleep.asleep && moving {
@@ -333,11 +327,20 @@ pub(super) fn gather_into_engine(
             resting_for: sleep.slow_for,
         },
     };
-    let mut rest: Vec<Rest> = all
-        .iter()
-        .map(|c| rest_of(c.6, c.2.0 != DVec2::ZERO))
-        .collect();
-    let entities: Vec<Entity> = all.iter().map(|(e, ..)| e).collect();
+    let all = circles.p0();
+    let count = order.entities().len();
+    let mut bodies = Vec::with_capacity(count);
+    let mut rest = Vec::with_capacity(count);
+    let mut entities = Vec::with_capacity(count);
+    let mut own_restitutions = Vec::with_capacity(if own.restitution { count } else { 0 });
+    order.each(&all, |_, (e, p, v, r, m, restitution, sleep)| {
+        bodies.push(CircleState::new(p.0, v.0, r.0).with_mass(m.0));
+        rest.push(rest_of(sleep, v.0 != DVec2::ZERO));
+        entities.push(e);
+        if own.restitution {
+            own_restitutions.push(restitution_of(restitution));
+        }
+    });
     if stopped() {
         return give_up(state);
     }
@@ -349,7 +352,6 @@ pub(super) fn gather_into_engine(
             *r = Rest::default();
         }
     }
-    let all = circles.p0();
     let layers = own.filters.gather(entities.iter().copied());
     let restitutions = (effects.restitution, effects.wall_restitution);
     let fall = (effects.gravity, &rest[..]);
@@ -367,7 +369,7 @@ pub(super) fn gather_into_engine(
     // Without the collisions effect circles pass through each other (they still hit walls).
     engine.set_pairs(effects.collisions);
     if own.restitution {
-        engine.set_own_restitutions(all.iter().map(|c| restitution_of(c.5)).collect());
+        engine.set_own_restitutions(own_restitutions);
     }
 
     if effects.is_rough() {

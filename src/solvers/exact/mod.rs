@@ -21,15 +21,19 @@ mod keep;
 mod outside;
 pub(crate) mod pack;
 
+use bevy::ecs::query::QueryItem;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use crate::base::arena::Arena;
 use crate::base::collision_layers::{CircleFilters, CollisionLayers, Sensor};
-use crate::base::components::{Inertia, Radius, Restitution, Sleep, SolverCircles, SpinCircles};
+use crate::base::components::{
+    Inertia, Radius, Restitution, Sleep, SolverCircles, SolverData, SpinCircles,
+};
 use crate::base::config::{Effects, Solver};
 use crate::base::hits::PairCollisions;
 use crate::base::hits::{CircleHit, WallHit};
+use crate::base::order::CircleOrder;
 use crate::base::segment::Segments;
 use crate::step::boundary::WallCollisions;
 use crate::step::integrate::turn_circles;
@@ -130,6 +134,7 @@ struct StepSetup<'w> {
     dt: Res<'w, StepDt>,
     budget: Res<'w, EventBudget>,
     stop: Option<Res<'w, StopRequest>>,
+    order: Res<'w, CircleOrder>,
 }
 
 /// The circles whose layers were set or changed, or that became sensors, since the last step:
@@ -183,6 +188,7 @@ fn continuous_step(
         dt,
         budget,
         stop,
+        order,
     } = setup;
     let (own_restitution, filters) = own;
     let slept = !circles.p5().is_empty();
@@ -193,7 +199,11 @@ fn continuous_step(
         slept,
     };
     gather_into_engine(
-        ((*solver, *arena, *effects, &segments), stop.as_deref()),
+        (
+            (*solver, *arena, *effects, &segments),
+            &order,
+            stop.as_deref(),
+        ),
         &mut state,
         own,
         &mut circles,
@@ -213,7 +223,7 @@ fn continuous_step(
             messages,
         );
     }
-    write_back(&mut state, &mut circles.p0());
+    write_back(&state, &order, &mut circles.p0());
     counted.sleeping.count = match still {
         true => age_rest(&state, &mut circles.p2(), dt.0),
         false => write_back_sleep(&state, &mut circles.p2(), counted.sleeping.count),
@@ -353,18 +363,14 @@ fn advance_engine(
     walls.impulse += stats.wall_impulse - last.wall_impulse;
 }
 
-/// Writes the engine's positions and velocities back to the circles that changed. Circles found
-/// in another order than the engine's (an entity moved between archetypes) are written by
-/// entity, and the next step rebuilds.
-fn write_back(state: &mut EngineState, circles: &mut SolverCircles) {
+/// Writes the engine's positions and velocities back to the circles that changed, in serial
+/// order (by entity if the circles are no longer the engine's: spawned or despawned in the
+/// step, and the next step rebuilds).
+fn write_back(state: &EngineState, order: &CircleOrder, circles: &mut SolverCircles) {
     let Some(engine) = state.engine.as_ref() else {
         return;
     };
-    for (i, (entity, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
-        if state.entities.get(i) != Some(&entity) {
-            state.reordered = true;
-            break;
-        }
+    let write = |i: usize, (_, mut p, mut v, ..): QueryItem<'_, '_, SolverData>| {
         let (position, velocity) = (engine.position(i), engine.velocity(i));
         if p.0 != position {
             p.0 = position;
@@ -372,11 +378,13 @@ fn write_back(state: &mut EngineState, circles: &mut SolverCircles) {
         if v.0 != velocity {
             v.0 = velocity;
         }
-    }
-    if state.reordered {
+    };
+    if order.entities() == state.entities {
+        order.each_mut(circles, write);
+    } else {
         for (i, &entity) in state.entities.iter().enumerate() {
-            if let Ok((_, mut p, mut v, ..)) = circles.get_mut(entity) {
-                (p.0, v.0) = (engine.position(i), engine.velocity(i));
+            if let Ok(item) = circles.get_mut(entity) {
+                write(i, item);
             }
         }
     }

@@ -31,6 +31,7 @@ use crate::base::components::{Friction, Restitution, SolverCircles, SpinCircles}
 use crate::base::config::{Effects, SoftConfig, Solver};
 use crate::base::hits::PairCollisions;
 use crate::base::hits::{CircleHit, HitLog, WallHit};
+use crate::base::order::CircleOrder;
 use crate::base::segment::{SegmentCells, Segments};
 use crate::step::boundary::WallCollisions;
 use crate::step::schedule::{CircleSystems, SoftStep, StepDt};
@@ -132,7 +133,7 @@ fn step_soft(
     (own, filters): (Own, CircleFilters),
     counted: (ResMut<PairCollisions>, ResMut<WallCollisions>),
     mut messages: (MessageWriter<CircleHit>, MessageWriter<WallHit>),
-    (mut circles, mut spins): (SolverCircles, SpinCircles),
+    (order, mut circles, mut spins): (Res<CircleOrder>, SolverCircles, SpinCircles),
 ) {
     let SoftSetup {
         solver,
@@ -154,7 +155,7 @@ fn step_soft(
     let per_circle = (!own.0.is_empty(), !own.1.is_empty());
     bodies.clear();
     entities.clear();
-    for (entity, p, v, r, m, restitution, sleep) in &circles {
+    order.each(&circles, |_, (entity, p, v, r, m, restitution, sleep)| {
         // A sleeping circle is an immovable circle at rest until it is woken.
         let inverse = if sleep.asleep { 0.0 } else { m.inverse() };
         bodies.push(entity.to_bits(), p.0, v.0, r.0, inverse);
@@ -165,7 +166,7 @@ fn step_soft(
                 .push(restitution.map_or(scene, |own| own.0));
         }
         entities.push(entity);
-    }
+    });
     bodies.layers = filters.gather(entities.iter().copied());
     // Spin only where something may turn: friction, or a circle turning already.
     let spinning = effects.has_friction()
@@ -219,7 +220,7 @@ fn step_soft(
         log.send_circle_hits(|i| entities[i as usize], 0.0, &mut messages.0);
         log.send_wall_hits(|i| entities[i as usize], 0.0, &mut messages.1);
     }
-    for (i, (_, mut p, mut v, ..)) in circles.iter_mut().enumerate() {
+    order.each_mut(&mut circles, |i, (_, mut p, mut v, ..)| {
         let (position, velocity) = (bodies.position[i], bodies.velocity[i]);
         if p.0 != position {
             p.0 = position;
@@ -227,7 +228,7 @@ fn step_soft(
         if v.0 != velocity {
             v.0 = velocity;
         }
-    }
+    });
     if !bodies.angular_velocity.is_empty() {
         write_back_spin(bodies, entities, &mut spins);
     }

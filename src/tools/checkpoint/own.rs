@@ -111,13 +111,10 @@ pub(super) fn check(own: &[OwnParts], circles: usize) -> Result<(), String> {
 
 /// Puts `own` back on the circles `entities` (the checkpoint's circles, in order, as resumed).
 ///
-/// Bevy groups entities by the components they have, and the solvers take the circles in
-/// query order, which follows those groups and the order they were made in. Circles given one
-/// kind of part come back in their order (the checkpoint lists them in query order, and the
-/// parts go on in that order), so the run resumes bit for bit; where circles have parts of
-/// several kinds the groups may come back in another order, and the run goes on equal to
-/// rounding rather than bit for bit (what no code touched, every scene and `moving_circles
-/// run`, is bit for bit).
+/// Bevy groups entities by the components they have, so the resumed world's tables may come
+/// in another order than the paused one's; the solvers take the circles in serial order (the
+/// checkpoint's order, in which the circles are spawned again), so the run resumes bit for bit
+/// whatever parts the circles have.
 pub(super) fn apply(own: &[OwnParts], world: &mut World, entities: &[Entity]) {
     for parts in own {
         let mut e = world.entity_mut(entities[parts.circle as usize]);
