@@ -176,16 +176,14 @@ pub mod prelude {
     pub use crate::game::sensor::SensorPlugin;
     pub use crate::game::spawn::{Respawn, SpawnPlugin, SpawnReport};
     pub use crate::game::transform_sync::{DefaultSmoothing, Smoothing, TransformSyncPlugin};
-    pub use crate::solvers::discrete::CollidePlugin;
-    pub use crate::solvers::exact::{ContinuousPlugin, EventBudget};
-    pub use crate::solvers::soft::SoftPlugin;
+    pub use crate::solvers::discrete::{CollidePlugin, DiscretePlugin};
+    pub use crate::solvers::exact::{ContinuousPlugin, ContinuousStep, EventBudget};
+    pub use crate::solvers::soft::{SoftPlugin, SoftStep};
     pub use crate::step::boundary::{PeriodicPlugin, SegmentsPlugin, WallCollisions, WallsPlugin};
     pub use crate::step::effects::Effect;
     pub use crate::step::forces::{DragPlugin, GravityPlugin};
     pub use crate::step::integrate::IntegratePlugin;
-    pub use crate::step::schedule::{
-        CircleStep, CircleSystems, ContinuousStep, StepPlugin, StepTotals,
-    };
+    pub use crate::step::schedule::{CircleStep, CircleSystems, StepPlugin, StepTotals};
     pub use crate::step::sleep::{SleepPlugin, Sleeping};
     #[cfg(feature = "tools")]
     pub use crate::tools::scene::Scene;

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::step::schedule::scheduled_systems;
+use crate::step::schedule::{SolverSteps, scheduled_systems};
 use crate::tools::io::say;
 use crate::tools::run::headless_app;
 use crate::tools::scene::Scene;
@@ -10,15 +10,12 @@ use crate::tools::scene::Scene;
 /// Prints the systems the scene at `scene` schedules, for the step schedule its solver runs.
 pub fn systems(scene: &Path) -> anyhow::Result<()> {
     let config = Scene::load(scene)?;
-    // Each solver runs one of the step schedules; the others' systems never run for it.
-    let step = if config.solver.is_continuous() {
-        "ContinuousStep"
-    } else if config.solver.is_soft() {
-        "SoftStep"
-    } else {
-        "CircleStep"
-    };
+    let solver = config.solver;
     let mut app = headless_app(config);
+    // Each solver runs one of the step schedules; the others' systems never run for it.
+    let steps = app.world().resource::<SolverSteps>();
+    let step = steps.of(solver).map(|s| format!("{:?}", s.schedule));
+    let step = step.unwrap_or_default();
     for (schedule, system) in scheduled_systems(&mut app) {
         if schedule.ends_with("Step") && schedule != step {
             continue;

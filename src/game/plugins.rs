@@ -9,7 +9,7 @@ use crate::game::query::SpatialQueryPlugin;
 use crate::game::sensor::SensorPlugin;
 use crate::game::spawn::SpawnPlugin;
 use crate::game::transform_sync::TransformSyncPlugin;
-use crate::solvers::discrete::CollidePlugin;
+use crate::solvers::discrete::{CollidePlugin, DiscretePlugin};
 use crate::solvers::exact::ContinuousPlugin;
 use crate::solvers::soft::SoftPlugin;
 use crate::step::boundary::{PeriodicPlugin, SegmentsPlugin, WallsPlugin};
@@ -21,7 +21,8 @@ use crate::step::sleep::SleepPlugin;
 /// The simulation as a plugin group: [`StepPlugin`] (first: the others build on it),
 /// [`SpawnPlugin`], [`IntegratePlugin`], one plugin per effect ([`GravityPlugin`],
 /// [`DragPlugin`], [`SegmentsPlugin`], [`WallsPlugin`], [`PeriodicPlugin`], [`CollidePlugin`]),
-/// [`ContinuousPlugin`] (the `swept` and `exact` solvers), [`SoftPlugin`] (the `soft` contact
+/// one plugin per solver ([`DiscretePlugin`]: `discrete` and `substeps=N`;
+/// [`ContinuousPlugin`]: `swept` and `exact`; [`SoftPlugin`]: the `soft` contact
 /// solver), [`SleepPlugin`], [`SensorPlugin`] (what overlaps each
 /// [`Sensor`](crate::base::collision_layers::Sensor)), [`DiagnosticsPlugin`], [`TransformSyncPlugin`] (each circle's
 /// `Transform`, if it has one, follows its [`Position`](crate::base::components::Position) smoothly between fixed steps) and
@@ -86,6 +87,7 @@ impl PluginGroup for CirclesPlugins {
             .add(WallsPlugin)
             .add(PeriodicPlugin)
             .add(CollidePlugin)
+            .add(DiscretePlugin)
             .add(ContinuousPlugin)
             .add(SoftPlugin)
             .add(SleepPlugin)

@@ -106,11 +106,12 @@ struct Recipe {
     systems: SystemsRecipe,
 }
 
-/// The effects whose plugins are present (each with the recipe of its systems), and the ones
-/// whose systems are in the schedule right now.
+/// The effects whose plugins are present (each with the recipes of its systems: the effect's
+/// own plugin's, and a solver's that takes the effect in its own schedule), and the ones whose
+/// systems are in the schedule right now.
 #[derive(Resource, Default)]
 pub struct EffectRegistry {
-    recipes: HashMap<Effect, Recipe>,
+    recipes: HashMap<Effect, Vec<Recipe>>,
     scheduled: HashSet<Effect>,
 }
 
@@ -128,7 +129,8 @@ impl EffectRegistry {
 
 /// Registers `effect`'s systems, made by `systems`, for `schedules`; adds them now if the app's
 /// [`Effects`], [`Arena`] and [`Segments`] call for the effect. What an effect plugin calls from
-/// `build`.
+/// `build`, and a solver's plugin for an effect it takes in its own schedule (drag, under
+/// `swept` and `exact`).
 pub fn register_effect(
     app: &mut App,
     effect: Effect,
@@ -148,13 +150,10 @@ pub fn register_effect(
         }
     }
     let mut registry = app.world_mut().get_resource_or_init::<EffectRegistry>();
-    registry.recipes.insert(
-        effect,
-        Recipe {
-            schedules: schedules.to_vec(),
-            systems,
-        },
-    );
+    registry.recipes.entry(effect).or_default().push(Recipe {
+        schedules: schedules.to_vec(),
+        systems,
+    });
     if called_for {
         registry.scheduled.insert(effect);
     }
@@ -180,7 +179,7 @@ pub fn reconcile_effects(world: &mut World) {
         .filter(|e| e.is_called_for(&effects, boundary, &segments))
         .collect();
     let mut labels: Vec<Interned<dyn ScheduleLabel>> = Vec::new();
-    for recipe in recipes.values() {
+    for recipe in recipes.values().flatten() {
         for label in &recipe.schedules {
             if !labels.contains(label) {
                 labels.push(*label);
@@ -190,7 +189,10 @@ pub fn reconcile_effects(world: &mut World) {
     for label in labels {
         world.schedule_scope(label, |world, schedule| {
             for &effect in scheduled.difference(&wanted) {
-                if !recipes[&effect].schedules.contains(&label) {
+                if !recipes[&effect]
+                    .iter()
+                    .any(|r| r.schedules.contains(&label))
+                {
                     continue;
                 }
                 if let Err(e) = schedule.remove_systems_in_set(
@@ -202,9 +204,10 @@ pub fn reconcile_effects(world: &mut World) {
                 }
             }
             for &effect in wanted.difference(&scheduled) {
-                let recipe = &recipes[&effect];
-                if recipe.schedules.contains(&label) {
-                    schedule.add_systems((recipe.systems)().in_set(EffectSystems(effect)));
+                for recipe in recipes[&effect].iter() {
+                    if recipe.schedules.contains(&label) {
+                        schedule.add_systems((recipe.systems)().in_set(EffectSystems(effect)));
+                    }
                 }
             }
         });

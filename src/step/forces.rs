@@ -1,18 +1,20 @@
 //! The force effects: [`GravityPlugin`] (`v += g·dt`, under the discrete solvers; `swept` and
 //! `exact` fly parabolas and `soft` integrates gravity in its substeps) and [`DragPlugin`]
-//! (`v *= exp(-drag·dt)`, under every solver but `soft`, which applies it itself), in
-//! [`CircleSystems::Forces`] before the move. Each schedules its system
+//! (`v *= exp(-drag·dt)`, under the discrete solvers; `swept` and `exact` schedule the same
+//! system in their own step, and `soft` applies it itself), in [`CircleSystems::Forces`]
+//! before the move. Each schedules its system
 //! only when the scene calls for it (`effects.gravity`, `effects.drag`). Immovable circles
 //! (static and kinematic) and sleeping ones are left alone.
 
-use bevy::ecs::schedule::ScheduleLabel;
+use bevy::ecs::schedule::{ScheduleConfigs, ScheduleLabel};
+use bevy::ecs::system::ScheduleSystem;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::base::components::{Mass, Sleep, Velocity};
 use crate::base::config::Effects;
 use crate::step::effects::{Effect, EffectSystems, register_effect};
-use crate::step::schedule::{CircleStep, CircleSystems, ContinuousStep, StepDt};
+use crate::step::schedule::{CircleStep, CircleSystems, StepDt};
 
 /// Constant acceleration `effects.gravity`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -35,18 +37,17 @@ pub struct DragPlugin;
 
 impl Plugin for DragPlugin {
     fn build(&self, app: &mut App) {
-        register_effect(
-            app,
-            Effect::Drag,
-            &[CircleStep.intern(), ContinuousStep.intern()],
-            || {
-                apply_drag
-                    .in_set(CircleSystems::Forces)
-                    .after(EffectSystems(Effect::Gravity))
-                    .into_configs()
-            },
-        );
+        register_effect(app, Effect::Drag, &[CircleStep.intern()], drag_systems);
     }
+}
+
+/// Drag's system, in [`CircleSystems::Forces`] after gravity: what [`DragPlugin`] schedules in
+/// [`CircleStep`], and a solver that takes drag from outside in its own schedule.
+pub(crate) fn drag_systems() -> ScheduleConfigs<ScheduleSystem> {
+    apply_drag
+        .in_set(CircleSystems::Forces)
+        .after(EffectSystems(Effect::Gravity))
+        .into_configs()
 }
 
 /// `v += g·dt` for every movable circle.

@@ -1,21 +1,24 @@
 //! When things run: the public [`CircleSystems`] sets, the [`CircleStep`] schedule that one
-//! (sub)step of the discrete solvers runs, the [`ContinuousStep`] schedule of `swept` and
-//! `exact`, the [`SoftStep`] schedule of the contact solver, the [`StepTotals`] they advance,
-//! and [`StepPlugin`], the core plugin every other plugin builds on.
+//! substep of the discrete solvers runs, the registry in which each solver's plugin registers
+//! the schedule that advances it ([`register_solver`]), the [`StepTotals`] they advance, and
+//! [`StepPlugin`], the core plugin every other plugin builds on.
 //!
-//! Data flow per fixed step (in `FixedUpdate`):
-//! `CircleSystems::Step` runs [`CircleStep`] `substeps` times with `dt / substeps`
-//! (`Forces` → `Integrate` → `Boundary` → `Collide`), or [`ContinuousStep`] once
-//! (`Forces` → `Continuous`), or [`SoftStep`] once (`Forces` → `Soft`, which substeps inside),
-//! then `CircleSystems::Diagnostics` measures the result. Before the step, `CircleSystems::Sleep`
-//! puts circles at rest to sleep and wakes the ones that were hit or moved.
-//! Spawning happens outside the fixed clock (`Startup` and `PreUpdate`, set `CircleSystems::Spawn`)
-//! so a paused simulation can still be reset.
+//! Data flow per fixed step (in `FixedUpdate`): `CircleSystems::Step` orders the circles
+//! ([`CircleOrder`]) and runs the current solver's schedule as many times as it has substeps,
+//! with `dt / substeps`: [`CircleStep`] (`Forces` → `Integrate` → `Boundary` → `Collide`) under
+//! `discrete` and `substeps=N`, the event engine's schedule once under `swept` and `exact`, the
+//! contact solver's once under `soft` (which substeps inside); then `CircleSystems::Diagnostics`
+//! measures the result. Before the step, `CircleSystems::Sleep` puts circles at rest to sleep
+//! and wakes the ones that were hit or moved. Spawning happens outside the fixed clock
+//! (`Startup` and `PreUpdate`, set `CircleSystems::Spawn`) so a paused simulation can still be
+//! reset.
 
 use std::time::Duration;
 
-use bevy::ecs::schedule::ScheduleLabel;
-use bevy::ecs::schedule::SingleThreadedExecutor;
+use bevy::ecs::schedule::{
+    InternedScheduleLabel, InternedSystemSet, IntoScheduleConfigs, ScheduleLabel,
+    SingleThreadedExecutor,
+};
 use bevy::ecs::system::SystemState;
 use bevy::prelude::*;
 
@@ -35,7 +38,8 @@ pub enum CircleSystems {
     Sleep,
     /// Advancing one fixed step: runs [`CircleStep`] (`FixedUpdate`).
     Step,
-    /// Forces that change velocity: gravity, drag (inside [`CircleStep`]).
+    /// Forces that change velocity: gravity, drag, yours (inside every solver's schedule,
+    /// before the solver's own sets).
     Forces,
     /// Moving circles over the step's `dt` (inside [`CircleStep`]).
     Integrate,
@@ -43,11 +47,6 @@ pub enum CircleSystems {
     Boundary,
     /// Resolving circle-circle contacts (inside [`CircleStep`]).
     Collide,
-    /// Advancing a whole step continuously: `swept` / `exact` (inside [`ContinuousStep`]).
-    Continuous,
-    /// Advancing a whole step with the contact solver, `soft` (inside [`SoftStep`]): its own
-    /// substeps, gravity, drag, walls and contacts.
-    Soft,
     /// Finding what overlaps each sensor after the step (`FixedUpdate`).
     Sensors,
     /// Measuring energy, momentum and collision rates after the step (`FixedUpdate`).
@@ -58,16 +57,46 @@ pub enum CircleSystems {
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CircleStep;
 
-/// The schedule of one step of the continuous solvers (`swept`, `exact`): the force effects,
-/// then [`CircleSystems::Continuous`], which handles motion, walls and collisions together.
-#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct ContinuousStep;
+/// How one solver advances a fixed step, as its plugin registers it with [`register_solver`].
+#[derive(Clone, Copy, Debug)]
+pub struct SolverStep {
+    /// Whether this is the step of `solver`.
+    pub advances: fn(Solver) -> bool,
+    /// The schedule one run covers.
+    pub schedule: InternedScheduleLabel,
+    /// How many runs of `schedule` make a fixed step under `solver`, each over `dt / runs`.
+    pub runs: fn(Solver) -> u32,
+}
 
-/// The schedule of one step of the contact solver (`soft`): force effects of your own in
-/// [`CircleSystems::Forces`], then [`CircleSystems::Soft`], which integrates gravity and drag
-/// itself in every substep.
-#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct SoftStep;
+/// The solvers' steps, one per solver plugin present.
+#[derive(Resource, Default, Debug)]
+pub struct SolverSteps(Vec<SolverStep>);
+
+impl SolverSteps {
+    /// The step that advances `solver`, if its plugin is present.
+    pub fn of(&self, solver: Solver) -> Option<SolverStep> {
+        self.0.iter().copied().find(|step| (step.advances)(solver))
+    }
+}
+
+/// Registers `step` as the way to advance the solvers it names, and makes its schedule: run
+/// by one thread (a step's systems run in a chain, so more threads would only add wake-ups to
+/// every substep), with [`CircleSystems::Forces`] first and then `own`, the solver's sets.
+pub fn register_solver(
+    app: &mut App,
+    step: SolverStep,
+    own: impl IntoScheduleConfigs<InternedSystemSet, ()>,
+) {
+    app.init_schedule(step.schedule)
+        .edit_schedule(step.schedule, |s| {
+            s.set_executor(SingleThreadedExecutor::new());
+        })
+        .configure_sets(step.schedule, own.after(CircleSystems::Forces));
+    app.world_mut()
+        .get_resource_or_init::<SolverSteps>()
+        .0
+        .push(step);
+}
 
 /// The simulated time one run of [`CircleStep`] covers, in seconds (`dt / substeps`).
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Default)]
@@ -122,8 +151,9 @@ impl StopRequest {
     }
 }
 
-/// The core plugin: inserts the arena, segment walls, solver and effect parameters, sets the fixed clock, builds [`CircleStep`]
-/// and orders the [`CircleSystems`] sets. The other plugins add systems to those sets. Before
+/// The core plugin: inserts the arena, segment walls, solver and effect parameters, sets the
+/// fixed clock, orders the [`CircleSystems`] sets of `FixedUpdate` and runs the solver's step
+/// in them. The other plugins add systems to those sets and register the solvers. Before
 /// each fixed step (`FixedFirst`) it reconciles the effects' systems with the [`Effects`],
 /// [`Arena`] and [`Segments`] if any of them changed, however they were changed.
 #[derive(Clone, Debug)]
@@ -174,38 +204,7 @@ impl Plugin for StepPlugin {
             .init_resource::<SubstepStart>()
             .init_resource::<StepTotals>()
             .init_resource::<CircleOrder>()
-            .init_schedule(CircleStep)
-            .init_schedule(ContinuousStep)
-            .init_schedule(SoftStep)
-            // The step's systems run in a chain, so a multi-threaded executor would only add
-            // thread wake-ups to every substep.
-            .edit_schedule(CircleStep, |s| {
-                s.set_executor(SingleThreadedExecutor::new());
-            })
-            .edit_schedule(ContinuousStep, |s| {
-                s.set_executor(SingleThreadedExecutor::new());
-            })
-            .edit_schedule(SoftStep, |s| {
-                s.set_executor(SingleThreadedExecutor::new());
-            })
-            .configure_sets(
-                ContinuousStep,
-                (CircleSystems::Forces, CircleSystems::Continuous).chain(),
-            )
-            .configure_sets(
-                SoftStep,
-                (CircleSystems::Forces, CircleSystems::Soft).chain(),
-            )
-            .configure_sets(
-                CircleStep,
-                (
-                    CircleSystems::Forces,
-                    CircleSystems::Integrate,
-                    CircleSystems::Boundary,
-                    CircleSystems::Collide,
-                )
-                    .chain(),
-            )
+            .init_resource::<SolverSteps>()
             .configure_sets(
                 FixedUpdate,
                 (
@@ -242,11 +241,14 @@ pub(crate) fn allow_long_steps(fixed: Res<Time<Fixed>>, mut virt: ResMut<Time<Vi
 }
 
 /// Advances one fixed step with the current [`Solver`]: orders the circles by serial
-/// ([`CircleOrder`]), then runs [`CircleStep`] once per substep with the substep's `dt`, or
-/// [`ContinuousStep`] or [`SoftStep`] once.
+/// ([`CircleOrder`]), then runs the schedule its plugin registered as many times as it says,
+/// each over its share of `dt`. Without the solver's plugin nothing moves (said once).
 pub(crate) fn run_circle_step(
     world: &mut World,
-    circles: &mut SystemState<SerialCircles<'static, 'static>>,
+    (circles, mut warned): (
+        &mut SystemState<SerialCircles<'static, 'static>>,
+        Local<bool>,
+    ),
 ) {
     let mut order = std::mem::take(&mut *world.resource_mut::<CircleOrder>());
     let circles = circles.get(world).expect("a query is always valid");
@@ -254,25 +256,21 @@ pub(crate) fn run_circle_step(
     *world.resource_mut::<CircleOrder>() = order;
     let solver = *world.resource::<Solver>();
     let dt = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
-    let whole_step = if solver.is_continuous() {
-        Some(ContinuousStep.intern())
-    } else if solver.is_soft() {
-        Some(SoftStep.intern())
-    } else {
-        None
-    };
-    if let Some(schedule) = whole_step {
-        world.resource_mut::<StepDt>().0 = dt;
-        world.resource_mut::<SubstepStart>().0 = 0.0;
-        world.run_schedule(schedule);
-    } else {
-        let substeps = solver.substeps();
-        let sub_dt = dt / f64::from(substeps);
-        world.resource_mut::<StepDt>().0 = sub_dt;
-        for k in 0..substeps {
-            world.resource_mut::<SubstepStart>().0 = f64::from(k) * sub_dt;
-            world.run_schedule(CircleStep);
+    match world.resource::<SolverSteps>().of(solver) {
+        Some(step) => {
+            let runs = (step.runs)(solver).max(1);
+            let sub_dt = dt / f64::from(runs);
+            world.resource_mut::<StepDt>().0 = sub_dt;
+            for k in 0..runs {
+                world.resource_mut::<SubstepStart>().0 = f64::from(k) * sub_dt;
+                world.run_schedule(step.schedule);
+            }
         }
+        None if !*warned => {
+            *warned = true;
+            warn!("no plugin advances the {solver} solver: the circles stay where they are");
+        }
+        None => {}
     }
     let mut totals = world.resource_mut::<StepTotals>();
     totals.steps += 1;

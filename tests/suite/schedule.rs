@@ -1,5 +1,5 @@
-//! The schedule: no ambiguous system order, only the plugins a config calls for, and parts can be
-//! disabled the Bevy way.
+//! The schedule: no ambiguous system order, only the plugins a config calls for, parts can be
+//! disabled the Bevy way, and a solver is whatever plugin registers its step.
 
 use crate::common::*;
 use bevy::app::PluginGroup;
@@ -170,4 +170,89 @@ fn diagnostics_are_measured_every_step_except_while_a_headless_run_steps() {
     assert_eq!(*app.world().resource::<Measuring>(), Measuring::EveryStep);
     step(&mut app, 1);
     assert_relative("after the run", energy(&app), 16.0 * before, 1e-9);
+}
+
+/// The schedule of the stand-in solver below.
+#[derive(bevy::ecs::schedule::ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct DriftStep;
+
+/// A stand-in for `soft`, registered as any solver registers its step: each of its two runs a
+/// fixed step moves every circle right by the run's `dt`, whatever its velocity.
+struct DriftPlugin;
+
+impl Plugin for DriftPlugin {
+    fn build(&self, app: &mut App) {
+        use bevy::ecs::schedule::ScheduleLabel;
+        use moving_circles::step::schedule::{SolverStep, StepDt, register_solver};
+        #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        struct DriftSystems;
+        let step = SolverStep {
+            advances: Solver::is_soft,
+            schedule: DriftStep.intern(),
+            runs: |_| 2,
+        };
+        register_solver(app, step, DriftSystems);
+        let drift = |dt: Res<StepDt>, mut circles: Query<&mut Position>| {
+            circles.iter_mut().for_each(|mut p| p.0.x += dt.0);
+        };
+        app.add_systems(DriftStep, drift.in_set(DriftSystems));
+    }
+}
+
+/// A headless soft gas without `SoftPlugin`, with `setup` added, stepped once.
+fn soft_app_without_its_plugin(setup: impl FnOnce(&mut App)) -> App {
+    use bevy::time::TimeUpdateStrategy;
+    let config = CirclesConfig {
+        solver: Solver::Soft(4),
+        spawn: SpawnConfig {
+            count: 50,
+            ..default()
+        },
+        ..default()
+    };
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        CirclesPlugins::new(config).build().disable::<SoftPlugin>(),
+    ))
+    .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
+    setup(&mut app);
+    app.finish();
+    app.cleanup();
+    app.update();
+    app
+}
+
+#[test]
+fn a_solver_is_replaced_by_a_plugin_that_registers_its_step() {
+    let mut app = soft_app_without_its_plugin(|app| {
+        app.add_plugins(DriftPlugin);
+    });
+    let before = circles(&mut app);
+    let steps = app.world().resource::<StepTotals>().steps;
+    step(&mut app, 3);
+    let after = circles(&mut app);
+    assert_eq!(app.world().resource::<StepTotals>().steps, steps + 3);
+    assert!(!before.is_empty());
+    let dt = app
+        .world()
+        .resource::<Time<Fixed>>()
+        .timestep()
+        .as_secs_f64();
+    for (was, now) in before.iter().zip(&after) {
+        assert!(
+            (now.0.x - was.0.x - 3.0 * dt).abs() < 1e-12,
+            "{was:?} -> {now:?}"
+        );
+        assert_eq!(now.0.y, was.0.y);
+    }
+}
+
+#[test]
+fn without_the_solvers_plugin_the_circles_stay_where_they_are() {
+    let mut app = soft_app_without_its_plugin(|_| {});
+    let before = circles(&mut app);
+    assert!(before.iter().any(|c| c.1 != bevy::math::DVec2::ZERO));
+    step(&mut app, 3);
+    assert_eq!(circles(&mut app), before);
 }

@@ -1,5 +1,6 @@
 //! The course's method, `discrete` and `substeps=N`: the step's forces, integration and walls
-//! (`crate::step`), then circle-circle collisions. [`CollidePlugin`] schedules the collision
+//! (`crate::step`), then circle-circle collisions. [`DiscretePlugin`] registers the step:
+//! [`CircleStep`] run once per substep over `dt / substeps`. [`CollidePlugin`] schedules the collision
 //! system when the scene calls for collisions: it gathers the circles into the [`pass`]'s flat
 //! arrays, which finds overlapping pairs with the broad phase and resolves each with the
 //! contact kernel (both in `crate::collision`), and scatters the result back. On a periodic
@@ -13,12 +14,35 @@ use bevy::prelude::*;
 use crate::base::arena::Arena;
 use crate::base::collision_layers::CircleFilters;
 use crate::base::components::{Restitution, SolverCircles};
-use crate::base::config::Effects;
+use crate::base::config::{Effects, Solver};
 use crate::base::hits::{CircleHit, HitLog, PairCollisions};
 use crate::base::order::CircleOrder;
 use crate::step::effects::{Effect, register_effect};
-use crate::step::schedule::{CircleStep, CircleSystems, StepDt, SubstepStart};
+use crate::step::schedule::{
+    CircleStep, CircleSystems, SolverStep, StepDt, SubstepStart, register_solver,
+};
 use pass::{ContactScratch, resolve_all_contacts};
+
+/// The discrete solvers, `discrete` and `substeps=N`: [`CircleStep`] (forces, integration,
+/// walls, collisions, each from its own plugin) run once per substep.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DiscretePlugin;
+
+impl Plugin for DiscretePlugin {
+    fn build(&self, app: &mut App) {
+        let step = SolverStep {
+            advances: Solver::is_discrete,
+            schedule: CircleStep.intern(),
+            runs: Solver::substeps,
+        };
+        let sets = (
+            CircleSystems::Integrate,
+            CircleSystems::Boundary,
+            CircleSystems::Collide,
+        );
+        register_solver(app, step, sets.chain());
+    }
+}
 
 /// Resolves overlaps between circles: separation plus restitution impulse (`effects.restitution`),
 /// in [`CircleSystems::Collide`]. Without collisions in the scene (or with this plugin disabled)

@@ -22,6 +22,7 @@ mod outside;
 pub(crate) mod pack;
 
 use bevy::ecs::query::QueryItem;
+use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
@@ -36,8 +37,10 @@ use crate::base::hits::{CircleHit, WallHit};
 use crate::base::order::CircleOrder;
 use crate::base::segment::Segments;
 use crate::step::boundary::WallCollisions;
+use crate::step::effects::{Effect, register_effect};
+use crate::step::forces::drag_systems;
 use crate::step::integrate::turn_circles;
-use crate::step::schedule::{CircleSystems, ContinuousStep, StepDt, StopRequest};
+use crate::step::schedule::{SolverStep, StepDt, StopRequest, register_solver};
 use crate::step::sleep::Sleeping;
 use keep::{EngineViews, Own, gather_into_engine};
 
@@ -94,8 +97,17 @@ impl EventBudget {
     }
 }
 
-/// The `swept` and `exact` solvers: their step in [`ContinuousStep`] (your forces in
-/// [`CircleSystems::Forces`], then [`CircleSystems::Continuous`]), run once a fixed step.
+/// The schedule of one step of `swept` and `exact`: drag and your forces in
+/// [`CircleSystems::Forces`](crate::step::schedule::CircleSystems::Forces), then [`ContinuousSystems`], which handles motion, walls and
+/// collisions together.
+#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ContinuousStep;
+
+/// The continuous step itself, in [`ContinuousStep`] after the forces.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ContinuousSystems;
+
+/// The `swept` and `exact` solvers: their step in [`ContinuousStep`], run once a fixed step.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContinuousPlugin;
 
@@ -108,11 +120,16 @@ impl Plugin for ContinuousPlugin {
             .init_resource::<PairCollisions>()
             .init_resource::<WallCollisions>()
             .add_message::<CircleHit>()
-            .add_message::<WallHit>()
-            .add_systems(
-                ContinuousStep,
-                continuous_step.in_set(CircleSystems::Continuous),
-            );
+            .add_message::<WallHit>();
+        let step = SolverStep {
+            advances: Solver::is_continuous,
+            schedule: ContinuousStep.intern(),
+            runs: |_| 1,
+        };
+        register_solver(app, step, ContinuousSystems);
+        // The engine flies circles under gravity itself; drag it takes from outside.
+        register_effect(app, Effect::Drag, &[ContinuousStep.intern()], drag_systems);
+        app.add_systems(ContinuousStep, continuous_step.in_set(ContinuousSystems));
     }
 }
 

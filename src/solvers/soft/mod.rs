@@ -6,7 +6,7 @@
 //! them all `N` times per step, relaxing after each substep and bouncing once at the end above
 //! a restitution threshold (`solve.rs`). Tuned by [`SoftConfig`].
 //!
-//! [`SoftPlugin`] adds one system to [`SoftStep`]: gather the circles, step the kernel
+//! [`SoftPlugin`] registers the solver's step, [`SoftStep`], and adds one system to it: gather the circles, step the kernel
 //! (`soft_step`), write back what changed. It integrates gravity and drag itself in every
 //! substep, and handles the arena's walls, segment walls and collisions, so the effect plugins
 //! add nothing to this schedule: what a scene calls for is what the kernel is told to do.
@@ -21,6 +21,7 @@ pub(crate) mod sequential;
 pub(crate) mod solve;
 pub(crate) mod stats;
 
+use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -34,7 +35,7 @@ use crate::base::hits::{CircleHit, HitLog, WallHit};
 use crate::base::order::CircleOrder;
 use crate::base::segment::{SegmentCells, Segments};
 use crate::step::boundary::WallCollisions;
-use crate::step::schedule::{CircleSystems, SoftStep, StepDt};
+use crate::step::schedule::{SolverStep, StepDt, register_solver};
 pub(crate) use bodies::Bodies;
 pub use bodies::Softness;
 pub use cache::CacheSnapshot;
@@ -42,8 +43,18 @@ pub(crate) use cache::ContactCache;
 pub(crate) use solve::{SoftParams, SoftScratch, soft_step};
 pub(crate) use stats::SoftStats;
 
-/// The contact solver `soft`: its step in [`SoftStep`] (your forces in
-/// [`CircleSystems::Forces`], then [`CircleSystems::Soft`]), run once a fixed step.
+/// The schedule of one step of the contact solver: your forces in
+/// [`CircleSystems::Forces`](crate::step::schedule::CircleSystems::Forces), then [`SoftSystems`], which integrates gravity and drag itself in
+/// every substep.
+#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SoftStep;
+
+/// The contact solver's step itself, in [`SoftStep`] after the forces.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SoftSystems;
+
+/// The contact solver `soft`: its step in [`SoftStep`], run once a fixed step (its substeps
+/// are its own).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SoftPlugin;
 
@@ -56,8 +67,14 @@ impl Plugin for SoftPlugin {
             .init_resource::<WallCollisions>()
             .register_type::<Friction>()
             .add_message::<CircleHit>()
-            .add_message::<WallHit>()
-            .add_systems(SoftStep, step_soft.in_set(CircleSystems::Soft));
+            .add_message::<WallHit>();
+        let step = SolverStep {
+            advances: Solver::is_soft,
+            schedule: SoftStep.intern(),
+            runs: |_| 1,
+        };
+        register_solver(app, step, SoftSystems);
+        app.add_systems(SoftStep, step_soft.in_set(SoftSystems));
     }
 }
 
