@@ -199,7 +199,7 @@ pub struct Sleep {
 
 /// The circles as every solver's systems read and write them (the discrete contact pass, the
 /// wall bounce, the continuous step), in one query type so each sees them in the same order.
-pub type SolverCircles<'w, 's> = Query<'w, 's, SolverData>;
+pub type SolverCircles<'w, 's> = Query<'w, 's, SolverData, With<CircleSerial>>;
 
 /// What [`SolverCircles`] fetches of each circle.
 pub type SolverData = (

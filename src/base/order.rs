@@ -33,6 +33,7 @@ pub type SerialCircles<'w, 's> = Query<
 #[derive(Resource, Default, Debug)]
 pub struct CircleOrder {
     entities: Vec<Entity>,
+    serials: Vec<u64>,
     keyed: Vec<(CircleSerial, Entity)>,
     in_query_order: bool,
 }
@@ -41,6 +42,7 @@ impl CircleOrder {
     /// Orders `circles`, given in the order a query over them yields them.
     pub fn update(&mut self, circles: impl Iterator<Item = (Entity, CircleSerial)>) {
         self.entities.clear();
+        self.serials.clear();
         self.keyed.clear();
         let mut last = None;
         self.in_query_order = true;
@@ -53,11 +55,18 @@ impl CircleOrder {
             self.keyed.sort_unstable();
         }
         self.entities.extend(self.keyed.iter().map(|&(_, e)| e));
+        self.serials.extend(self.keyed.iter().map(|&(s, _)| s.0));
     }
 
     /// The circles' entities in serial order.
     pub fn entities(&self) -> &[Entity] {
         &self.entities
+    }
+
+    /// The circles' serials, in order: what the solvers key what they keep between steps by
+    /// (a circle keeps its serial in a world rebuilt with new entities).
+    pub fn serials(&self) -> &[u64] {
+        &self.serials
     }
 
     /// Whether a query over the circles yields them in serial order already.
@@ -102,6 +111,15 @@ impl CircleOrder {
             }
         }
     }
+}
+
+/// The serials of `entities`, circles from [`snapshot_with_entities`], which lists only
+/// circles with one.
+///
+/// [`snapshot_with_entities`]: crate::base::circle::snapshot_with_entities
+pub fn serials_of(world: &World, entities: &[Entity]) -> Vec<u64> {
+    let serial = |&e: &Entity| world.get::<CircleSerial>(e).expect("a circle has a serial");
+    entities.iter().map(|e| serial(e).0).collect()
 }
 
 #[cfg(test)]

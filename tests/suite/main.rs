@@ -38,6 +38,7 @@ mod pinned;
 mod properties;
 mod queries;
 mod resume;
+mod rollback;
 mod rough;
 mod scenes;
 mod schedule;

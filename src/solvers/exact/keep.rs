@@ -29,7 +29,7 @@ const MOVED_FOR_REBUILD: usize = 4;
 
 /// The engine kept between `exact` steps, with the entities of its circles (in serial order,
 /// [`CircleOrder`], when it was built) and, once a step needs it, each one's index.
-#[derive(Resource, Default)]
+#[derive(Resource, Default, Clone)]
 pub struct EngineState {
     pub(super) engine: Option<EventEngine>,
     pub(super) entities: Vec<Entity>,
@@ -146,6 +146,16 @@ impl EngineState {
         self.setup = Some((arena, effects, Solver::Exact));
         self.segments = segments.clone();
         Ok(())
+    }
+
+    /// Takes the circles `entities` (in serial order, the engine's) as the engine's, where a
+    /// rollback put back an engine saved with other entities for the same circles.
+    pub(crate) fn rekey(&mut self, entities: &[Entity]) {
+        if self.entities != entities {
+            self.entities.clear();
+            self.entities.extend_from_slice(entities);
+            self.index.clear();
+        }
     }
 
     /// Takes `entities` as the engine's circles, in index order.

@@ -171,17 +171,24 @@ struct Lost<'w, 's> {
 }
 
 impl Lost<'_, '_> {
-    /// Whether any circle lost its own restitution, moment of inertia, layers or sensor since
-    /// the last look (and forgets it).
-    fn any(&mut self) -> bool {
-        let lost = !self.restitution.is_empty()
-            || !self.inertia.is_empty()
-            || !self.layers.is_empty()
-            || !self.sensor.is_empty();
-        self.restitution.clear();
-        self.inertia.clear();
-        self.layers.clear();
-        self.sensor.clear();
+    /// Whether any circle still `alive` lost its own restitution, moment of inertia, layers or
+    /// sensor since the last look (and forgets it). A despawned circle's losses are not: that
+    /// circles went is what the step sees from their count (and a rollback library despawns
+    /// circles to spawn them again with all their parts).
+    fn any(&mut self, alive: impl Fn(Entity) -> bool) -> bool {
+        let mut lost = false;
+        for entity in self.restitution.read() {
+            lost |= alive(entity);
+        }
+        for entity in self.inertia.read() {
+            lost |= alive(entity);
+        }
+        for entity in self.layers.read() {
+            lost |= alive(entity);
+        }
+        for entity in self.sensor.read() {
+            lost |= alive(entity);
+        }
         lost
     }
 }
@@ -209,8 +216,12 @@ fn continuous_step(
     } = setup;
     let (own_restitution, filters) = own;
     let slept = !circles.p5().is_empty();
+    let lost = {
+        let all = circles.p0();
+        lost.any(|e| all.contains(e))
+    };
     let own = Own {
-        lost: lost.any() || !relayered.is_empty(),
+        lost: lost || !relayered.is_empty(),
         restitution: !own_restitution.is_empty(),
         filters: &filters,
         slept,

@@ -52,7 +52,37 @@ pub struct ContactCache {
     stepped: bool,
 }
 
+impl Clone for ContactCache {
+    fn clone(&self) -> Self {
+        let mut copy = Self::default();
+        copy.copy_kept_from(self);
+        copy
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.copy_kept_from(source);
+    }
+}
+
 impl ContactCache {
+    /// Becomes a copy of what `other` keeps for the next step (its circles, contacts and
+    /// impulses; the lookups a step makes are made again), reusing its own buffers: what a
+    /// rollback saves and restores.
+    pub fn copy_kept_from(&mut self, other: &ContactCache) {
+        self.ids.clone_from(&other.ids);
+        self.stored.clone_from(&other.stored);
+        self.owners.clone_from(&other.owners);
+        self.stepped = other.stepped;
+        self.cursor = 0;
+        self.index_of.clear();
+        self.start.clear();
+    }
+
+    /// Bytes of what [`ContactCache::copy_kept_from`] copies.
+    pub fn kept_bytes(&self) -> usize {
+        size_of_val(&self.ids[..]) + size_of_val(&self.stored[..]) + size_of_val(&self.owners[..])
+    }
+
     /// Gives every contact in `constraints` the impulse it ended last step with, and whether
     /// it pushed then (and its row in `rows`, if it has friction, the friction and rolling
     /// impulses it ended with). `ids` are the circles' identities now. A step calls it for its

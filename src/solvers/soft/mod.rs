@@ -93,18 +93,26 @@ pub struct SoftState {
 }
 
 impl SoftState {
-    /// The contact cache as data for a checkpoint of `circles` (in the checkpoint's order), or
-    /// `None` before the first step.
-    pub fn snapshot(&self, circles: &[Entity]) -> Option<CacheSnapshot> {
-        let order: Vec<u64> = circles.iter().map(|e| e.to_bits()).collect();
-        self.cache.snapshot(&order)
+    /// The contacts and impulses the next step warm starts from.
+    pub(crate) fn contacts(&self) -> &ContactCache {
+        &self.cache
     }
 
-    /// Puts back the contact cache of a checkpoint for `circles` (in the checkpoint's order),
-    /// so that the next step warm starts as the run would have.
-    pub fn restore(&mut self, snapshot: &CacheSnapshot, circles: &[Entity]) -> Result<(), String> {
-        let ids: Vec<u64> = circles.iter().map(|e| e.to_bits()).collect();
-        self.cache = ContactCache::restore(snapshot, &ids)?;
+    /// [`SoftState::contacts`], to put back.
+    pub(crate) fn contacts_mut(&mut self) -> &mut ContactCache {
+        &mut self.cache
+    }
+
+    /// The contact cache as data for a checkpoint of the circles of these `serials` (in the
+    /// checkpoint's order), or `None` before the first step.
+    pub fn snapshot(&self, serials: &[u64]) -> Option<CacheSnapshot> {
+        self.cache.snapshot(serials)
+    }
+
+    /// Puts back the contact cache of a checkpoint for the circles of these `serials` (in the
+    /// checkpoint's order), so that the next step warm starts as the run would have.
+    pub fn restore(&mut self, snapshot: &CacheSnapshot, serials: &[u64]) -> Result<(), String> {
+        self.cache = ContactCache::restore(snapshot, serials)?;
         Ok(())
     }
 }
@@ -172,10 +180,11 @@ fn step_soft(
     let per_circle = (!own.0.is_empty(), !own.1.is_empty());
     bodies.clear();
     entities.clear();
-    order.each(&circles, |_, (entity, p, v, r, m, restitution, sleep)| {
+    let serials = order.serials();
+    order.each(&circles, |i, (entity, p, v, r, m, restitution, sleep)| {
         // A sleeping circle is an immovable circle at rest until it is woken.
         let inverse = if sleep.asleep { 0.0 } else { m.inverse() };
-        bodies.push(entity.to_bits(), p.0, v.0, r.0, inverse);
+        bodies.push(serials[i], p.0, v.0, r.0, inverse);
         if per_circle.0 {
             let scene = effects.restitution;
             bodies

@@ -20,6 +20,7 @@ use crate::base::config::{
 };
 use crate::base::error::InputError;
 use crate::base::hits::PairCollisions;
+use crate::base::order::serials_of;
 use crate::base::range::check_mass;
 use crate::base::segment::Segments;
 use crate::game::spawn::{Dropped, SpawnReport};
@@ -96,7 +97,9 @@ impl Checkpoint {
         let budget_exhausted = state.budget_exhausted;
         let circles: Vec<CircleState> = with_entities.into_iter().map(|(_, c)| c).collect();
         let contacts = if world.resource::<Solver>().is_soft() {
-            world.resource::<SoftState>().snapshot(&entities)
+            world
+                .resource::<SoftState>()
+                .snapshot(&serials_of(world, &entities))
         } else {
             None
         };
@@ -351,9 +354,10 @@ impl Checkpoint {
         }
         world.resource_mut::<Sleeping>().count = self.sleep.iter().filter(|s| s.asleep).count();
         if let Some(contacts) = &self.contacts {
+            let serials = serials_of(world, &entities);
             world
                 .resource_mut::<SoftState>()
-                .restore(contacts, &entities)
+                .restore(contacts, &serials)
                 .map_err(|message| InputError::whole(origin, message))?;
         }
         let mut state = world.resource_mut::<EngineState>();
