@@ -128,7 +128,8 @@
 //! describes the benchmarks.
 #![warn(missing_docs)]
 
-// The Rust examples of the README and of the guide's embedding page, compiled and run as
+// The Rust examples of the README and of the guide's embedding and rollback pages, compiled
+// and run as
 // doctests (`cargo test --doc`).
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
@@ -136,6 +137,9 @@ struct ReadmeDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/embedding.md")]
 struct EmbeddingDoctests;
+#[cfg(doctest)]
+#[doc = include_str!("../docs/rollback.md")]
+struct RollbackDoctests;
 
 pub mod base;
 #[cfg(feature = "cli")]

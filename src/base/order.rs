@@ -43,19 +43,25 @@ impl CircleOrder {
     pub fn update(&mut self, circles: impl Iterator<Item = (Entity, CircleSerial)>) {
         self.entities.clear();
         self.serials.clear();
-        self.keyed.clear();
         let mut last = None;
         self.in_query_order = true;
         for (entity, serial) in circles {
             self.in_query_order &= last < Some(serial);
             last = Some(serial);
-            self.keyed.push((serial, entity));
+            self.entities.push(entity);
+            self.serials.push(serial.0);
         }
         if !self.in_query_order {
+            self.keyed.clear();
+            let pairs = self.serials.iter().zip(&self.entities);
+            self.keyed
+                .extend(pairs.map(|(&s, &e)| (CircleSerial(s), e)));
             self.keyed.sort_unstable();
+            self.entities.clear();
+            self.serials.clear();
+            self.entities.extend(self.keyed.iter().map(|&(_, e)| e));
+            self.serials.extend(self.keyed.iter().map(|&(s, _)| s.0));
         }
-        self.entities.extend(self.keyed.iter().map(|&(_, e)| e));
-        self.serials.extend(self.keyed.iter().map(|&(s, _)| s.0));
     }
 
     /// The circles' entities in serial order.

@@ -62,7 +62,6 @@ pub(super) struct SnapshotQueries {
     pub(super) write: QueryState<MotionMut, With<Radius>>,
     pub(super) parts: QueryState<Parts, With<Radius>>,
     pub(super) ordered: Vec<(CircleSerial, Entity)>,
-    pub(super) in_query_order: bool,
     pub(super) extra: Vec<Entity>,
     pub(super) entities: Vec<Entity>,
 }
@@ -75,7 +74,6 @@ impl FromWorld for SnapshotQueries {
             write: world.query_filtered(),
             parts: world.query_filtered(),
             ordered: Vec::new(),
-            in_query_order: true,
             extra: Vec::new(),
             entities: Vec::new(),
         }
@@ -83,13 +81,25 @@ impl FromWorld for SnapshotQueries {
 }
 
 impl SnapshotQueries {
+    /// Whether a query yields the world's circles in serial order (one look at each serial;
+    /// saving then reads them as the query yields them).
+    pub(super) fn in_serial_order(&mut self, world: &World) -> bool {
+        let serials = self.serials.iter(world).map(|(_, &s)| s);
+        serials.is_sorted_by(|a, b| a < b)
+    }
+
+    /// Whether a query yields the world's circles with exactly the serials `serials` yields,
+    /// in that order (restoring then writes them as the query yields them).
+    pub(super) fn yields(&mut self, world: &World, serials: impl Iterator<Item = u64>) -> bool {
+        self.serials.iter(world).map(|(_, s)| s.0).eq(serials)
+    }
+
     /// Lists the world's circles in serial order.
     pub(super) fn order(&mut self, world: &World) {
         self.ordered.clear();
         self.ordered
             .extend(self.serials.iter(world).map(|(e, &serial)| (serial, e)));
-        self.in_query_order = self.ordered.is_sorted_by_key(|&(s, _)| s);
-        if !self.in_query_order {
+        if !self.ordered.is_sorted_by_key(|&(s, _)| s) {
             self.ordered.sort_unstable();
         }
     }

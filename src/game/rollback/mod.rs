@@ -118,7 +118,6 @@ impl CirclesSnapshot {
     pub fn save(&mut self, world: &mut World) {
         world.init_resource::<SnapshotQueries>();
         world.resource_scope(|world, mut queries: Mut<SnapshotQueries>| {
-            queries.order(world);
             self.serials.clear();
             self.flags.clear();
             self.words.clear();
@@ -129,10 +128,11 @@ impl CirclesSnapshot {
                 last = serial.0;
                 push_circle((&mut self.flags, &mut self.words), motion);
             };
-            if queries.in_query_order {
-                let circles = queries.ordered.iter().zip(queries.read.iter(world));
-                circles.for_each(|(&(serial, _), motion)| keep(serial, motion));
+            if queries.in_serial_order(world) {
+                let circles = queries.serials.iter(world).zip(queries.read.iter(world));
+                circles.for_each(|((_, &serial), motion)| keep(serial, motion));
             } else {
+                queries.order(world);
                 for &(serial, entity) in &queries.ordered {
                     if let Ok(motion) = queries.read.get(world, entity) {
                         keep(serial, motion);
@@ -166,8 +166,23 @@ impl CirclesSnapshot {
     pub fn restore(&self, world: &mut World) -> Result<(), RollbackError> {
         world.init_resource::<SnapshotQueries>();
         world.resource_scope(|world, mut queries: Mut<SnapshotQueries>| {
-            queries.order(world);
-            self.match_circles(&mut queries)?;
+            // Most often the world's circles are the snapshot's, in the order a query yields
+            // them: then they are written as it yields them.
+            let same = queries.yields(world, self.serial_values());
+            if same {
+                let SnapshotQueries {
+                    serials,
+                    entities,
+                    extra,
+                    ..
+                } = &mut *queries;
+                entities.clear();
+                entities.extend(serials.iter(world).map(|(e, _)| e));
+                extra.clear();
+            } else {
+                queries.order(world);
+                self.match_circles(&mut queries)?;
+            }
             let SnapshotQueries {
                 write,
                 parts,
@@ -176,13 +191,27 @@ impl CirclesSnapshot {
             } = &mut *queries;
             let (mut flags, mut words) = (self.flags.iter(), self.words.iter().copied());
             let old = long_ago(world);
-            for &entity in entities.iter() {
-                let (Some(&f), Ok(motion)) = (flags.next(), write.get_mut(world, entity)) else {
-                    continue;
-                };
-                put_back((f, old), &mut words, motion);
-                if let Ok(circle) = parts.get_mut(world, entity) {
-                    forget_changes(circle, old);
+            if same {
+                // The world's circles are the snapshot's, in the order a query yields them.
+                write
+                    .iter_mut(world)
+                    .zip(&mut flags)
+                    .for_each(|(motion, &f)| {
+                        put_back((f, old), &mut words, motion);
+                    });
+                parts
+                    .iter_mut(world)
+                    .for_each(|circle| forget_changes(circle, old));
+            } else {
+                for &entity in entities.iter() {
+                    let (Some(&f), Ok(motion)) = (flags.next(), write.get_mut(world, entity))
+                    else {
+                        continue;
+                    };
+                    put_back((f, old), &mut words, motion);
+                    if let Ok(circle) = parts.get_mut(world, entity) {
+                        forget_changes(circle, old);
+                    }
                 }
             }
             for &entity in &queries.extra {
@@ -221,9 +250,7 @@ impl CirclesSnapshot {
         queries.entities.clear();
         queries.extra.clear();
         let mut world = queries.ordered.iter().peekable();
-        let (mut bytes, mut serial) = (&self.serials[..], 0u64);
-        while !bytes.is_empty() {
-            serial += pop_serial(&mut bytes);
+        for serial in self.serial_values() {
             while let Some(&&(s, e)) = world.peek()
                 && s.0 < serial
             {
@@ -237,6 +264,17 @@ impl CirclesSnapshot {
         }
         queries.extra.extend(world.map(|&(_, e)| e));
         Ok(())
+    }
+
+    /// The snapshot's serials, in its order.
+    fn serial_values(&self) -> impl Iterator<Item = u64> + '_ {
+        let (mut bytes, mut serial) = (&self.serials[..], 0u64);
+        std::iter::from_fn(move || {
+            (!bytes.is_empty()).then(|| {
+                serial += pop_serial(&mut bytes);
+                serial
+            })
+        })
     }
 
     /// Circles in the snapshot.
