@@ -6,7 +6,7 @@
 use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use moving_circles::base::circle::{CircleState, snapshot};
+use moving_circles::base::circle::snapshot;
 use moving_circles::prelude::*;
 
 /// A component of the user's own.
@@ -56,17 +56,6 @@ fn query_order(app: &mut App) -> Vec<Entity> {
         .collect()
 }
 
-/// The exact bits of each circle's state, in serial order.
-fn bits(circles: &[CircleState]) -> Vec<[u64; 6]> {
-    circles
-        .iter()
-        .map(|c| {
-            let (p, v) = (c.position, c.velocity);
-            [p.x, p.y, v.x, v.y, c.angular_velocity, c.rotation].map(f64::to_bits)
-        })
-        .collect()
-}
-
 #[test]
 fn circles_moved_between_tables_step_to_the_same_bits_under_every_solver() {
     let mut differing = Vec::new();
@@ -97,7 +86,7 @@ fn circles_moved_between_tables_step_to_the_same_bits_under_every_solver() {
             left.iter().any(|c| c.velocity != DVec2::ZERO),
             "{solver}: nothing moves"
         );
-        let (left, moved) = (bits(&left), bits(&moved));
+        let (left, moved) = (state_bits(&left), state_bits(&moved));
         assert_eq!(left.len(), moved.len(), "{solver}");
         let differ = left.iter().zip(&moved).filter(|(a, b)| a != b).count();
         if differ > 0 {

@@ -25,12 +25,17 @@ impl Words {
     pub(super) const ASLEEP: u8 = 16;
 }
 
+/// The circles a snapshot holds: every entity the solvers step (a circle may lack its spin
+/// or angle: it does not turn). Every query of a save or restore has this filter, so they
+/// yield the same circles in the same order.
+pub(super) type Circles = (With<Radius>, With<Position>, With<Velocity>, With<Sleep>);
+
 /// A circle's parts a snapshot holds.
 pub(super) type Motion = (
     &'static Position,
     &'static Velocity,
-    &'static AngularVelocity,
-    &'static Rotation,
+    Option<&'static AngularVelocity>,
+    Option<&'static Rotation>,
     &'static Sleep,
 );
 
@@ -38,8 +43,8 @@ pub(super) type Motion = (
 pub(super) type MotionMut = (
     &'static mut Position,
     &'static mut Velocity,
-    &'static mut AngularVelocity,
-    &'static mut Rotation,
+    Option<&'static mut AngularVelocity>,
+    Option<&'static mut Rotation>,
     &'static mut Sleep,
 );
 
@@ -57,10 +62,10 @@ pub(super) type Parts = (
 /// so that a save or restore after the first allocates nothing.
 #[derive(Resource)]
 pub(super) struct SnapshotQueries {
-    pub(super) serials: QueryState<(Entity, &'static CircleSerial), With<Radius>>,
-    pub(super) read: QueryState<Motion, With<Radius>>,
-    pub(super) write: QueryState<MotionMut, With<Radius>>,
-    pub(super) parts: QueryState<Parts, With<Radius>>,
+    pub(super) serials: QueryState<(Entity, &'static CircleSerial), Circles>,
+    pub(super) read: QueryState<Motion, Circles>,
+    pub(super) write: QueryState<MotionMut, Circles>,
+    pub(super) parts: QueryState<Parts, Circles>,
     pub(super) ordered: Vec<(CircleSerial, Entity)>,
     pub(super) extra: Vec<Entity>,
     pub(super) entities: Vec<Entity>,
@@ -116,7 +121,8 @@ pub(super) fn push_circle(
         flags |= Words::VELOCITY;
         words.extend([v.0.x.to_bits(), v.0.y.to_bits()]);
     }
-    for (value, flag) in [(w.0, Words::SPIN), (a.0, Words::ROTATION)] {
+    let (w, a) = (w.map_or(0.0, |w| w.0), a.map_or(0.0, |a| a.0));
+    for (value, flag) in [(w, Words::SPIN), (a, Words::ROTATION)] {
         if value.to_bits() != 0 {
             flags |= flag;
             words.push(value.to_bits());
@@ -165,13 +171,17 @@ pub(super) fn put_back(
     };
     p.bypass_change_detection().0 = position;
     v.bypass_change_detection().0 = velocity;
-    w.bypass_change_detection().0 = spin;
-    a.bypass_change_detection().0 = angle;
+    if let Some(w) = w.as_mut() {
+        w.bypass_change_detection().0 = spin;
+        w.set_last_changed(long_ago);
+    }
+    if let Some(a) = a.as_mut() {
+        a.bypass_change_detection().0 = angle;
+        a.set_last_changed(long_ago);
+    }
     *rest.bypass_change_detection() = sleep;
     p.set_last_changed(long_ago);
     v.set_last_changed(long_ago);
-    w.set_last_changed(long_ago);
-    a.set_last_changed(long_ago);
     rest.set_last_changed(long_ago);
 }
 

@@ -200,6 +200,17 @@ pub fn state_hash(app: &mut App) -> u64 {
     hasher.finish()
 }
 
+/// The exact bits of each circle's motion, spin and angle, in the order given.
+pub fn state_bits(circles: &[CircleState]) -> Vec<[u64; 6]> {
+    circles
+        .iter()
+        .map(|c| {
+            let (p, v) = (c.position, c.velocity);
+            [p.x, p.y, v.x, v.y, c.angular_velocity, c.rotation].map(f64::to_bits)
+        })
+        .collect()
+}
+
 /// Kinetic energy and momentum, summed in f64.
 pub fn energy_momentum(app: &mut App) -> (f64, DVec2) {
     circles(app)
