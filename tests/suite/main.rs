@@ -39,6 +39,8 @@ mod properties;
 mod queries;
 mod resume;
 mod rollback;
+#[cfg(feature = "ggrs")]
+mod rollback_ggrs;
 mod rough;
 mod scenes;
 mod schedule;

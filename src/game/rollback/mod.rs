@@ -16,6 +16,8 @@
 //! fresh engine, and a run that rolls back would step to other bits than one that does not).
 
 mod circles;
+#[cfg(feature = "ggrs")]
+pub mod ggrs;
 
 use std::hash::{BuildHasher, Hasher};
 
