@@ -82,6 +82,50 @@ enum Command {
         #[arg(long, value_name = "PATH")]
         scene: PathBuf,
     },
+    /// Grids of headless runs: plan one from a spec into a folder, run its tasks (here, or as a
+    /// Slurm job array), see how far it is, merge the results.
+    #[command(subcommand)]
+    Sweep(SweepCommand),
+}
+
+#[derive(Subcommand, Debug)]
+enum SweepCommand {
+    /// Check a sweep spec (RON) and write its plan into DIR: the task list and the Slurm batch
+    /// script (prints the sbatch command).
+    Plan {
+        /// The sweep spec.
+        spec: PathBuf,
+        /// The sweep's folder.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
+    /// Run one task of the sweep in DIR (its index from SLURM_ARRAY_TASK_ID without --index);
+    /// goes on from its checkpoint if it has one; does nothing if it is done.
+    Task {
+        /// The sweep's folder.
+        dir: PathBuf,
+        /// The task's index (from 0).
+        #[arg(long)]
+        index: Option<usize>,
+    },
+    /// Run every task of the sweep in DIR that has no result, here, JOBS at a time.
+    Run {
+        /// The sweep's folder.
+        dir: PathBuf,
+        /// Tasks at once.
+        #[arg(long, default_value_t = 2)]
+        jobs: usize,
+    },
+    /// Say how many tasks of the sweep in DIR are done, started, failed (and why) and waiting.
+    Status {
+        /// The sweep's folder.
+        dir: PathBuf,
+    },
+    /// Merge the results of the sweep in DIR into DIR/merged.csv and DIR/merged.json.
+    Merge {
+        /// The sweep's folder.
+        dir: PathBuf,
+    },
 }
 
 /// Options of the windowed app.
@@ -280,6 +324,15 @@ fn main() -> ExitCode {
             .and_then(cli::run::run)
             .map(|finished| finished.exit_code()),
         Some(Command::Systems { scene }) => cli::systems::systems(&scene).map(|()| 0),
+        Some(Command::Sweep(command)) => match command {
+            SweepCommand::Plan { spec, out } => cli::sweep::plan(&spec, &out).map(|()| 0),
+            SweepCommand::Task { dir, index } => {
+                cli::sweep::task(&dir, index).map(|finished| finished.exit_code())
+            }
+            SweepCommand::Run { dir, jobs } => cli::sweep::run(&dir, jobs).map(|()| 0),
+            SweepCommand::Status { dir } => cli::sweep::status(&dir).map(|()| 0),
+            SweepCommand::Merge { dir } => cli::sweep::merge(&dir).map(|()| 0),
+        },
         Some(Command::Accuracy { out, scenes, quick }) => {
             cli::accuracy::accuracy(&out, &scenes, quick).map(|()| 0)
         }

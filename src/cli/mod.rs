@@ -4,6 +4,7 @@
 //! - [`run`]: a headless run of a scene or particle file, with report and dump;
 //! - [`accuracy`]: the accuracy study;
 //! - [`eos`]: the hard-disk equation of state;
+//! - [`sweep`]: grids of runs, planned for Slurm or run on this machine's cores, merged;
 //! - [`systems`]: the systems a scene schedules;
 //! - `app` (feature `render`): the windowed app.
 
@@ -19,6 +20,7 @@ pub mod accuracy;
 pub mod app;
 pub mod eos;
 pub mod run;
+pub mod sweep;
 pub mod systems;
 
 /// Makes the folder `out` (`--out`) if it is missing and checks that each of `names` can be

@@ -51,4 +51,5 @@ mod sleep;
 mod soft_promises;
 mod solvers;
 mod spawn;
+mod sweep;
 mod transform_sync;

@@ -176,6 +176,11 @@ impl Checkpoint {
         self.dt
     }
 
+    /// The fixed steps the run had advanced.
+    pub fn steps(&self) -> u64 {
+        self.steps.steps
+    }
+
     /// Whether the settings and every value are usable (the settings through the same checks
     /// as a scene's; circles within the physical range). Says what is wrong. What the reader
     /// applies, and what `moving_circles run` applies before it writes one.

@@ -1,0 +1,511 @@
+//! `moving_circles sweep`: a grid of headless runs ([`spec::SweepSpec`]) planned into a folder,
+//! run task by task (`sweep task`, by a Slurm job array or by `sweep run` on this machine's
+//! cores), watched (`sweep status`) and merged (`sweep merge`).
+//!
+//! The folder holds everything: `spec.ron` (the spec, its scene made absolute; written last,
+//! so a folder with one holds a whole plan), `tasks.jsonl` (one task a line), `sweep.sbatch`
+//! (the Slurm array), `work/` (a running task's checkpoint and report), `results/` (each
+//! finished task's report, put in place by a rename: a task has a result whole or none),
+//! `failed/` (why a task failed) and `logs/`. Each task is a `run` of the scene with the
+//! task's settings, so a task stopped by a signal writes a checkpoint and the next try goes on
+//! from it to the same bits.
+
+pub mod spec;
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+use anyhow::{Context, bail};
+
+use crate::cli::run::{Finished, Input, Length, RunOptions, SolverChoice};
+use crate::tools::checkpoint::Checkpoint;
+use crate::tools::io::{read_limited, say, write_atomically};
+use crate::tools::scene::Scene;
+use spec::{MAX_SPEC_BYTES, SpecLength, SweepSpec, Task};
+
+/// The files and folders of a planned sweep.
+struct Folder {
+    dir: PathBuf,
+}
+
+impl Folder {
+    fn spec(&self) -> PathBuf {
+        self.dir.join("spec.ron")
+    }
+    fn tasks(&self) -> PathBuf {
+        self.dir.join("tasks.jsonl")
+    }
+    fn script(&self) -> PathBuf {
+        self.dir.join("sweep.sbatch")
+    }
+    fn result(&self, index: usize) -> PathBuf {
+        self.dir.join("results").join(format!("{index}.json"))
+    }
+    fn failure(&self, index: usize) -> PathBuf {
+        self.dir.join("failed").join(format!("{index}.txt"))
+    }
+    fn checkpoint(&self, index: usize) -> PathBuf {
+        self.dir.join("work").join(format!("{index}.checkpoint"))
+    }
+    fn report(&self, index: usize) -> PathBuf {
+        self.dir.join("work").join(format!("{index}.report.json"))
+    }
+    fn log(&self, index: usize) -> PathBuf {
+        self.dir.join("logs").join(format!("{index}.log"))
+    }
+}
+
+/// A planned sweep, read back from its folder.
+struct Plan {
+    folder: Folder,
+    spec: SweepSpec,
+    tasks: Vec<Task>,
+}
+
+impl Plan {
+    /// Reads the plan in `dir`.
+    fn open(dir: &Path) -> anyhow::Result<Self> {
+        let folder = Folder {
+            dir: dir.to_owned(),
+        };
+        let spec_path = folder.spec();
+        if !spec_path.exists() {
+            bail!(
+                "{} holds no planned sweep (no spec.ron): plan one with `moving_circles sweep \
+                 plan SPEC --out {}`",
+                dir.display(),
+                dir.display()
+            );
+        }
+        let spec = SweepSpec::read(&spec_path).map_err(anyhow::Error::msg)?;
+        // The task list is the spec's, expanded again: the file is for people and Slurm's
+        // logs, and cannot disagree with the spec it came from.
+        let tasks = spec.tasks();
+        Ok(Self {
+            folder,
+            spec,
+            tasks,
+        })
+    }
+}
+
+/// `sweep plan`: checks the spec and its scene, and writes the plan into `out`.
+pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
+    let mut spec = SweepSpec::read(spec_path).map_err(anyhow::Error::msg)?;
+    let base = spec_path.parent().unwrap_or(Path::new("."));
+    let scene = base.join(&spec.scene);
+    let scene = scene
+        .canonicalize()
+        .with_context(|| format!("{}: scene: {}", spec_path.display(), scene.display()))?;
+    // The scene is checked now, not in each of a thousand tasks.
+    Scene::load(&scene)?;
+    spec.scene = scene;
+    let text = ron::ser::to_string_pretty(&spec, ron::ser::PrettyConfig::default())
+        .context("writing the spec")?;
+    let folder = Folder {
+        dir: out.to_owned(),
+    };
+    if let Ok(file) = std::fs::File::open(folder.spec()) {
+        let planned = read_limited(file, MAX_SPEC_BYTES).map_err(anyhow::Error::msg)?;
+        if planned == text {
+            say(format_args!(
+                "{} holds this sweep's plan already",
+                out.display()
+            ));
+            return Ok(());
+        }
+        bail!(
+            "{} holds another sweep's plan (its spec.ron differs from {}): plan into an empty \
+             folder, or remove that one",
+            out.display(),
+            spec_path.display()
+        );
+    }
+    for sub in ["results", "failed", "work", "logs"] {
+        let path = out.join(sub);
+        std::fs::create_dir_all(&path).with_context(|| format!("creating {}", path.display()))?;
+    }
+    let tasks = spec.tasks();
+    let mut lines = String::new();
+    for task in &tasks {
+        lines.push_str(&serde_json::to_string(task).context("a task as JSON")?);
+        lines.push('\n');
+    }
+    write_atomically(&folder.tasks(), lines.as_bytes())
+        .with_context(|| format!("writing {}", folder.tasks().display()))?;
+    let dir = out
+        .canonicalize()
+        .with_context(|| format!("{}", out.display()))?;
+    let script = batch_script(&spec, tasks.len(), &dir)?;
+    write_atomically(&folder.script(), script.as_bytes())
+        .with_context(|| format!("writing {}", folder.script().display()))?;
+    // Last: a folder with a spec holds a whole plan.
+    write_atomically(&folder.spec(), text.as_bytes())
+        .with_context(|| format!("writing {}", folder.spec().display()))?;
+    say(format_args!(
+        "planned {} tasks in {}",
+        tasks.len(),
+        out.display()
+    ));
+    say(format_args!(
+        "  here:     moving_circles sweep run {} --jobs 2",
+        out.display()
+    ));
+    say(format_args!(
+        "  on Slurm: sbatch {}",
+        folder.script().display()
+    ));
+    Ok(())
+}
+
+/// The Slurm batch script of the whole array.
+fn batch_script(spec: &SweepSpec, tasks: usize, dir: &Path) -> anyhow::Result<String> {
+    let program = std::env::current_exe().context("finding this program")?;
+    let slurm = &spec.slurm;
+    let quote = |p: &Path| format!("'{}'", p.display().to_string().replace('\'', r"'\''"));
+    Ok(format!(
+        "#!/bin/bash\n\
+         # One Slurm array task per sweep task; each runs `moving_circles sweep task`, which\n\
+         # reads its index from SLURM_ARRAY_TASK_ID.\n\
+         #SBATCH --job-name=moving_circles-sweep\n\
+         # Tasks 0 to {last}, at most {concurrency} at once.\n\
+         #SBATCH --array=0-{last}%{concurrency}\n\
+         #SBATCH --ntasks=1\n\
+         #SBATCH --cpus-per-task=1\n\
+         #SBATCH --time={time}\n\
+         # SIGTERM {warn} s before the time limit: the task writes a checkpoint and stops;\n\
+         # requeued, it goes on from the checkpoint.\n\
+         #SBATCH --signal=B:TERM@{warn}\n\
+         #SBATCH --requeue\n\
+         #SBATCH --open-mode=append\n\
+         #SBATCH --output={dir}/logs/slurm-%A_%a.log\n\
+         # exec: the signal reaches the task itself, not a shell waiting for it.\n\
+         exec {program} sweep task {qdir}\n",
+        last = tasks - 1,
+        concurrency = slurm.concurrency,
+        time = slurm.time_limit,
+        warn = slurm.warn_seconds,
+        dir = dir.display(),
+        program = quote(&program),
+        qdir = quote(dir),
+    ))
+}
+
+/// `sweep task`: runs task `index` (from `SLURM_ARRAY_TASK_ID` when `None`), or does nothing
+/// if it has its result; goes on from its checkpoint if an earlier try left one.
+pub fn task(dir: &Path, index: Option<usize>) -> anyhow::Result<Finished> {
+    let plan = Plan::open(dir)?;
+    let index = match index {
+        Some(index) => index,
+        None => std::env::var("SLURM_ARRAY_TASK_ID")
+            .context("no --index and no SLURM_ARRAY_TASK_ID")?
+            .parse()
+            .context("SLURM_ARRAY_TASK_ID")?,
+    };
+    let Some(task) = plan.tasks.get(index) else {
+        bail!(
+            "task {index}: the sweep in {} has tasks 0 to {}",
+            dir.display(),
+            plan.tasks.len() - 1
+        );
+    };
+    let folder = &plan.folder;
+    let result = folder.result(index);
+    if result.exists() {
+        say(format_args!(
+            "task {index} is done already: {}",
+            result.display()
+        ));
+        return Ok(Finished::Completed);
+    }
+    let outcome = run_task(&plan, task);
+    match &outcome {
+        Ok(Finished::Completed) => {
+            std::fs::rename(folder.report(index), &result)
+                .with_context(|| format!("putting {} in place", result.display()))?;
+            let _ = std::fs::remove_file(folder.checkpoint(index));
+            let _ = std::fs::remove_file(folder.failure(index));
+        }
+        Ok(Finished::Interrupted { .. }) => {}
+        Err(e) => {
+            let _ = write_atomically(&folder.failure(index), format!("{e:#}\n").as_bytes());
+        }
+    }
+    outcome
+}
+
+/// Runs `task` from its scene, or from the checkpoint an earlier try left.
+fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
+    let folder = &plan.folder;
+    let checkpoint = folder.checkpoint(task.index);
+    let length = match task.length {
+        SpecLength::Steps(steps) => Length::Steps(steps),
+        SpecLength::Seconds(seconds) => Length::Seconds(seconds),
+    };
+    let mut options = RunOptions {
+        input: Input::Scene(plan.spec.scene.clone()),
+        solver: task
+            .solver
+            .as_deref()
+            .map(|s| s.parse().map(SolverChoice::Fixed))
+            .transpose()
+            .map_err(|e| anyhow::anyhow!("solver: {e}"))?,
+        tolerance: None,
+        dt: task.dt,
+        length,
+        seed: task.seed,
+        placement: None,
+        area_fraction: task.area_fraction,
+        report: Some(folder.report(task.index)),
+        dump: None,
+        threads: Some(1),
+        vector: true,
+        checkpoint: Some(checkpoint.clone()),
+        every: None,
+    };
+    if checkpoint.exists() {
+        let saved = Checkpoint::read(&checkpoint)?;
+        let total = match task.length {
+            SpecLength::Steps(steps) => steps,
+            SpecLength::Seconds(seconds) => (seconds / saved.dt()).ceil() as u64,
+        };
+        let done = saved.steps();
+        if done >= total {
+            // It ended, and was stopped before its report was put in place: run it again.
+            std::fs::remove_file(&checkpoint)
+                .with_context(|| format!("removing {}", checkpoint.display()))?;
+        } else {
+            say(format_args!(
+                "task {}: going on from {} at step {done} of {total}",
+                task.index,
+                checkpoint.display()
+            ));
+            options = RunOptions {
+                input: Input::Resume(checkpoint),
+                solver: None,
+                dt: None,
+                seed: None,
+                area_fraction: None,
+                length: Length::Steps(total - done),
+                ..options
+            };
+        }
+    }
+    crate::cli::run::run(options)
+}
+
+/// `sweep run`: every task without a result, `jobs` at a time, each a `sweep task` process
+/// writing into `logs/`.
+pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
+    if jobs == 0 {
+        bail!("--jobs must be at least 1");
+    }
+    let plan = Plan::open(dir)?;
+    let folder = &plan.folder;
+    let pending: Vec<usize> = (0..plan.tasks.len())
+        .filter(|&i| !folder.result(i).exists())
+        .collect();
+    let program = std::env::current_exe().context("finding this program")?;
+    let bar = indicatif::ProgressBar::new(pending.len() as u64).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} tasks  eta {eta}  {msg}")
+            .expect("valid template"),
+    );
+    let mut queue = pending.iter().copied();
+    let mut running: Vec<(usize, Child)> = Vec::new();
+    let mut failed = Vec::new();
+    loop {
+        while running.len() < jobs
+            && let Some(index) = queue.next()
+        {
+            let log = std::fs::OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(folder.log(index))
+                .with_context(|| format!("opening {}", folder.log(index).display()))?;
+            let child = Command::new(&program)
+                .args(["sweep", "task"])
+                .arg(dir)
+                .args(["--index", &index.to_string()])
+                .stdin(Stdio::null())
+                .stdout(log.try_clone()?)
+                .stderr(log)
+                .spawn()
+                .context("starting a task")?;
+            running.push((index, child));
+        }
+        if running.is_empty() {
+            break;
+        }
+        let mut k = 0;
+        while k < running.len() {
+            match running[k].1.try_wait()? {
+                Some(status) => {
+                    let (index, _) = running.swap_remove(k);
+                    if !status.success() {
+                        failed.push(index);
+                        bar.set_message(format!("{} failed", failed.len()));
+                    }
+                    bar.inc(1);
+                }
+                None => k += 1,
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    bar.finish_and_clear();
+    let done = pending.len() - failed.len();
+    say(format_args!(
+        "{done} of {} tasks done here ({} done before)",
+        pending.len(),
+        plan.tasks.len() - pending.len()
+    ));
+    if !failed.is_empty() {
+        failed.sort_unstable();
+        bail!(
+            "tasks {failed:?} failed: `moving_circles sweep status {}` says why",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// `sweep status`: how many tasks are done, started (a checkpoint, or running), failed (with
+/// the first line of why) and waiting.
+pub fn status(dir: &Path) -> anyhow::Result<()> {
+    let plan = Plan::open(dir)?;
+    let folder = &plan.folder;
+    let (mut done, mut started, mut waiting) = (0, 0, 0);
+    let mut failed = Vec::new();
+    for task in &plan.tasks {
+        let i = task.index;
+        if folder.result(i).exists() {
+            done += 1;
+        } else if let Ok(why) = std::fs::read_to_string(folder.failure(i)) {
+            failed.push((i, why.lines().next().unwrap_or("").to_owned()));
+        } else if folder.checkpoint(i).exists() || folder.report(i).exists() {
+            started += 1;
+        } else {
+            waiting += 1;
+        }
+    }
+    say(format_args!(
+        "{} tasks: {done} done, {started} started (running, or stopped with a checkpoint), {} \
+         failed, {waiting} waiting",
+        plan.tasks.len(),
+        failed.len()
+    ));
+    for (i, why) in &failed {
+        say(format_args!("  task {i} failed: {why}"));
+    }
+    Ok(())
+}
+
+/// `sweep merge`: every task's settings and report as one row, into `merged.csv` and
+/// `merged.json` in the sweep's folder; every task must be done.
+pub fn merge(dir: &Path) -> anyhow::Result<()> {
+    let plan = Plan::open(dir)?;
+    let folder = &plan.folder;
+    let missing: Vec<usize> = (0..plan.tasks.len())
+        .filter(|&i| !folder.result(i).exists())
+        .collect();
+    if !missing.is_empty() {
+        let shown: Vec<_> = missing.iter().take(20).collect();
+        bail!(
+            "{} of {} tasks have no result yet (tasks {shown:?}{}): `moving_circles sweep status \
+             {}`",
+            missing.len(),
+            plan.tasks.len(),
+            if missing.len() > shown.len() {
+                ", ..."
+            } else {
+                ""
+            },
+            dir.display()
+        );
+    }
+    let mut rows = Vec::new();
+    for task in &plan.tasks {
+        let path = folder.result(task.index);
+        let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
+        let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
+        let report: serde_json::Value = serde_json::from_str(&text)
+            .ok()
+            .filter(serde_json::Value::is_object)
+            .with_context(|| format!("{}: not a run report", path.display()))?;
+        rows.push(serde_json::json!({ "task": task, "report": report }));
+    }
+    let json = serde_json::to_string_pretty(&rows)?;
+    let csv = csv_of(&rows)?;
+    let [csv_path, json_path] = ["merged.csv", "merged.json"].map(|name| dir.join(name));
+    write_atomically(&csv_path, csv.as_bytes())
+        .with_context(|| format!("writing {}", csv_path.display()))?;
+    write_atomically(&json_path, json.as_bytes())
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    say(format_args!(
+        "merged {} tasks into {} and {}",
+        rows.len(),
+        csv_path.display(),
+        json_path.display()
+    ));
+    Ok(())
+}
+
+/// The rows as CSV: the task's settings (`task`, `task_solver`, ...) then the report's fields,
+/// arrays of numbers split into `name_0`, `name_1`, ..., other arrays as their items with
+/// spaces between, objects as a column for each of their fields.
+fn csv_of(rows: &[serde_json::Value]) -> anyhow::Result<String> {
+    let flat: Vec<Vec<(String, String)>> = rows
+        .iter()
+        .map(|row| {
+            let mut cells = flatten(&row["task"], "task_");
+            if let Some(k) = cells.iter().position(|(k, _)| k == "task_index") {
+                let (_, index) = cells.remove(k);
+                cells.insert(0, ("task".into(), index));
+            }
+            cells.extend(flatten(&row["report"], ""));
+            cells
+        })
+        .collect();
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    if let Some(first) = flat.first() {
+        writer.write_record(first.iter().map(|(k, _)| k))?;
+    }
+    for row in &flat {
+        writer.write_record(row.iter().map(|(_, v)| v))?;
+    }
+    Ok(String::from_utf8(writer.into_inner()?)?)
+}
+
+/// An object's fields as `(column, text)`, each column named `prefix` and its key.
+fn flatten(object: &serde_json::Value, prefix: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let Some(object) = object.as_object() else {
+        return out;
+    };
+    for (key, value) in object {
+        let key = format!("{prefix}{key}");
+        match value {
+            serde_json::Value::Array(items) if items.iter().all(|v| v.is_number()) => {
+                for (k, item) in items.iter().enumerate() {
+                    out.push((format!("{key}_{k}"), text_of(item)));
+                }
+            }
+            serde_json::Value::Array(items) => {
+                let words: Vec<String> = items.iter().map(text_of).collect();
+                out.push((key.clone(), words.join(" ")));
+            }
+            serde_json::Value::Object(_) => out.extend(flatten(value, &format!("{key}_"))),
+            _ => out.push((key, text_of(value))),
+        }
+    }
+    out
+}
+
+/// A JSON value as a CSV cell.
+fn text_of(value: &serde_json::Value) -> String {
+    match value {
+        serde_json::Value::Null => String::new(),
+        serde_json::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}

@@ -1,0 +1,334 @@
+//! A sweep spec (RON): the scene every task starts from, the axes its tasks vary (solver,
+//! step, seed, area fraction, length), how they combine, and how the Slurm array runs them;
+//! checked like a scene, each error naming its field, and expanded into [`Task`]s.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::base::config::{DT_RANGE, Solver};
+use crate::base::error::FieldError;
+
+/// Most tasks one sweep may have: a grid that large is a typo (an axis listed twice), and its
+/// task list alone would be gigabytes.
+pub const MAX_TASKS: usize = 100_000;
+
+/// The longest a spec file may be.
+pub const MAX_SPEC_BYTES: u64 = 1 << 20;
+
+/// What a sweep runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// The scene every task starts from, relative to the spec's folder.
+    pub scene: PathBuf,
+    /// How long each task runs (an axis `steps` or `seconds` overrides it).
+    pub length: SpecLength,
+    /// What the tasks vary.
+    #[serde(default)]
+    pub axes: Vec<Axis>,
+    /// How the axes combine.
+    #[serde(default)]
+    pub combine: Combine,
+    /// How Slurm runs the array.
+    #[serde(default)]
+    pub slurm: SlurmSettings,
+}
+
+/// How long a task runs.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpecLength {
+    /// Fixed steps.
+    Steps(u64),
+    /// Simulated seconds.
+    Seconds(f64),
+}
+
+/// One thing the tasks vary, with its values.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Axis {
+    /// Solvers by name (`exact`, `substeps=4`, `soft=8`, ...).
+    Solver(Vec<String>),
+    /// Fixed steps in seconds.
+    Dt(Vec<f64>),
+    /// Placement seeds.
+    Seed(Vec<u64>),
+    /// The area fraction the scene's random circles fill.
+    AreaFraction(Vec<f64>),
+    /// Run lengths in steps.
+    Steps(Vec<u64>),
+}
+
+impl Axis {
+    /// Its name in a spec.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Solver(_) => "solver",
+            Self::Dt(_) => "dt",
+            Self::Seed(_) => "seed",
+            Self::AreaFraction(_) => "area_fraction",
+            Self::Steps(_) => "steps",
+        }
+    }
+
+    /// Its number of values.
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Solver(v) => v.len(),
+            Self::Dt(v) | Self::AreaFraction(v) => v.len(),
+            Self::Seed(v) | Self::Steps(v) => v.len(),
+        }
+    }
+
+    /// Whether it has no value.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sets its `k`-th value on `task`.
+    fn set(&self, k: usize, task: &mut Task) {
+        match self {
+            Self::Solver(v) => task.solver = Some(v[k].clone()),
+            Self::Dt(v) => task.dt = Some(v[k]),
+            Self::Seed(v) => task.seed = Some(v[k]),
+            Self::AreaFraction(v) => task.area_fraction = Some(v[k]),
+            Self::Steps(v) => task.length = SpecLength::Steps(v[k]),
+        }
+    }
+
+    /// Checks each value, naming `field` (e.g. `axes[1]`) in an error.
+    fn check(&self, field: &str) -> Result<(), FieldError> {
+        let field = format!("{field}.{}", self.name());
+        if self.is_empty() {
+            return Err(FieldError::new(field, "has no values: give at least one"));
+        }
+        let bad =
+            |k: usize, message: String| Err(FieldError::new(format!("{field}[{k}]"), message));
+        match self {
+            Self::Solver(v) => {
+                for (k, name) in v.iter().enumerate() {
+                    if let Err(e) = name.parse::<Solver>() {
+                        return bad(k, e.to_string());
+                    }
+                }
+            }
+            Self::Dt(v) => {
+                let (lo, hi) = DT_RANGE;
+                for (k, &dt) in v.iter().enumerate() {
+                    if !(dt.is_finite() && (lo..=hi).contains(&dt)) {
+                        return bad(
+                            k,
+                            format!("must be between {lo} and {hi} seconds, got {dt}"),
+                        );
+                    }
+                }
+            }
+            Self::AreaFraction(v) => {
+                for (k, &phi) in v.iter().enumerate() {
+                    if !(phi.is_finite() && phi > 0.0 && phi < 1.0) {
+                        return bad(k, format!("must be between 0 and 1, got {phi}"));
+                    }
+                }
+            }
+            Self::Steps(v) => check_steps(v, &field)?,
+            Self::Seed(_) => {}
+        }
+        Ok(())
+    }
+}
+
+/// Checks run lengths in steps.
+fn check_steps(steps: &[u64], field: &str) -> Result<(), FieldError> {
+    let max = crate::cli::run::MAX_STEPS;
+    match steps.iter().position(|&s| !(1..=max).contains(&s)) {
+        Some(k) => Err(FieldError::new(
+            format!("{field}[{k}]"),
+            format!("must be from 1 to {max} steps, got {}", steps[k]),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// How the axes make tasks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Combine {
+    /// Every combination of one value of each axis (the first axis varies slowest).
+    #[default]
+    Product,
+    /// The `k`-th value of every axis together: the axes have the same number of values.
+    Zip,
+}
+
+/// How the Slurm array runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SlurmSettings {
+    /// Tasks running at once (`--array=0-N%K`).
+    pub concurrency: u32,
+    /// Each task's time limit (`--time`, e.g. `"00:30:00"`).
+    pub time_limit: String,
+    /// Seconds before the limit at which a task is told to checkpoint and stop (SIGTERM); it
+    /// is requeued and goes on from its checkpoint.
+    pub warn_seconds: u32,
+}
+
+impl Default for SlurmSettings {
+    fn default() -> Self {
+        Self {
+            concurrency: 16,
+            time_limit: "01:00:00".into(),
+            warn_seconds: 60,
+        }
+    }
+}
+
+/// One task of a sweep: the scene's settings with what the axes set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Task {
+    /// Its index in the sweep (Slurm's array index).
+    pub index: usize,
+    /// The solver, if an axis sets it (else the scene's).
+    pub solver: Option<String>,
+    /// The fixed step, if an axis sets it.
+    pub dt: Option<f64>,
+    /// The placement seed, if an axis sets it.
+    pub seed: Option<u64>,
+    /// The area fraction, if an axis sets it.
+    pub area_fraction: Option<f64>,
+    /// How long it runs.
+    pub length: SpecLength,
+}
+
+impl SweepSpec {
+    /// Parses and checks a spec's text; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Self, String> {
+        let spec: Self = ron::Options::default()
+            .from_str(text)
+            .map_err(|e| format!("{origin}: {e}"))?;
+        spec.check().map_err(|e| format!("{origin}: {e}"))?;
+        Ok(spec)
+    }
+
+    /// Reads and checks the spec at `path`.
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = crate::tools::io::read_limited(file, MAX_SPEC_BYTES)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Checks every field.
+    pub fn check(&self) -> Result<(), FieldError> {
+        match self.length {
+            SpecLength::Steps(steps) => check_steps(&[steps], "length.steps")?,
+            SpecLength::Seconds(s) if !(s.is_finite() && s > 0.0 && s <= 1e9) => {
+                return Err(FieldError::new(
+                    "length.seconds",
+                    format!("must be above 0 and at most 1e9, got {s}"),
+                ));
+            }
+            SpecLength::Seconds(_) => {}
+        }
+        for (k, axis) in self.axes.iter().enumerate() {
+            axis.check(&format!("axes[{k}]"))?;
+            if let Some(j) = self.axes[..k].iter().position(|a| a.name() == axis.name()) {
+                return Err(FieldError::new(
+                    format!("axes[{k}]"),
+                    format!("`{}` is already axes[{j}]", axis.name()),
+                ));
+            }
+        }
+        if self.combine == Combine::Zip
+            && let Some(first) = self.axes.first()
+            && let Some(k) = self.axes.iter().position(|a| a.len() != first.len())
+        {
+            return Err(FieldError::new(
+                "combine",
+                format!(
+                    "`zip` pairs the axes' values one for one, but axes[0] has {} and axes[{k}] {}",
+                    first.len(),
+                    self.axes[k].len()
+                ),
+            ));
+        }
+        let tasks = self.task_count();
+        if tasks.is_none_or(|n| n > MAX_TASKS) {
+            let count = tasks.map_or("more than 2^64".into(), |n| n.to_string());
+            return Err(FieldError::new(
+                "axes",
+                format!("make {count} tasks, more than the {MAX_TASKS} a sweep may have"),
+            ));
+        }
+        let slurm = &self.slurm;
+        if slurm.concurrency == 0 {
+            return Err(FieldError::new("slurm.concurrency", "must be at least 1"));
+        }
+        if !is_slurm_time(&slurm.time_limit) {
+            return Err(FieldError::new(
+                "slurm.time_limit",
+                format!(
+                    "{:?} is not a Slurm time such as \"30:00\", \"01:00:00\" or \"2-00:00:00\"",
+                    slurm.time_limit
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The number of tasks, `None` past `usize`.
+    pub fn task_count(&self) -> Option<usize> {
+        match self.combine {
+            Combine::Product => self
+                .axes
+                .iter()
+                .try_fold(1usize, |n, a| n.checked_mul(a.len())),
+            Combine::Zip => Some(self.axes.first().map_or(1, Axis::len)),
+        }
+    }
+
+    /// Every task, in index order.
+    pub fn tasks(&self) -> Vec<Task> {
+        let count = self.task_count().expect("a checked spec");
+        (0..count)
+            .map(|index| {
+                let mut task = Task {
+                    index,
+                    solver: None,
+                    dt: None,
+                    seed: None,
+                    area_fraction: None,
+                    length: self.length,
+                };
+                let mut rest = index;
+                // The last axis varies fastest.
+                for axis in self.axes.iter().rev() {
+                    let k = match self.combine {
+                        Combine::Product => {
+                            let k = rest % axis.len();
+                            rest /= axis.len();
+                            k
+                        }
+                        Combine::Zip => index,
+                    };
+                    axis.set(k, &mut task);
+                }
+                task
+            })
+            .collect()
+    }
+}
+
+/// Whether `s` is a Slurm time limit: `M`, `M:S`, `H:M:S`, `D-H`, `D-H:M` or `D-H:M:S`.
+fn is_slurm_time(s: &str) -> bool {
+    let (days, clock) = match s.split_once('-') {
+        Some((d, rest)) => (Some(d), rest),
+        None => (None, s),
+    };
+    let numbers = |t: &str| !t.is_empty() && t.len() <= 4 && t.bytes().all(|b| b.is_ascii_digit());
+    let parts: Vec<&str> = clock.split(':').collect();
+    days.is_none_or(numbers) && parts.len() <= 3 && parts.iter().all(|p| numbers(p))
+}
