@@ -108,7 +108,7 @@ enum SweepCommand {
         #[arg(long)]
         index: Option<usize>,
     },
-    /// Run every task of the sweep in DIR that has no result, here, JOBS at a time.
+    /// Run every task of the sweep in DIR that has no result, here, JOBS at a time; then merge.
     Run {
         /// The sweep's folder.
         dir: PathBuf,
@@ -121,7 +121,8 @@ enum SweepCommand {
         /// The sweep's folder.
         dir: PathBuf,
     },
-    /// Merge the results of the sweep in DIR into DIR/merged.csv and DIR/merged.json.
+    /// Merge the results of the sweep in DIR into DIR/merged.csv and DIR/merged.json, and draw
+    /// the figure its spec asks for.
     Merge {
         /// The sweep's folder.
         dir: PathBuf,

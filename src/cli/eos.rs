@@ -29,7 +29,15 @@ pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
         points.push(point);
     }
     bar.finish_and_clear();
-    write_results(&points, &EosFigure(&points), out, "eos")
+    write_results(
+        &points,
+        &EosFigure {
+            points: &points,
+            bars: "block error bars",
+        },
+        out,
+        "eos",
+    )
 }
 
 fn row(p: &EosPoint) -> String {

@@ -139,6 +139,200 @@ fn a_task_stopped_by_sigterm_goes_on_from_its_checkpoint_to_the_same_result() {
 }
 
 #[test]
+fn a_field_axis_runs_each_task_on_its_own_scene_file_and_bad_fields_are_refused() {
+    let dir = scratch_dir("sweep", "field");
+    let spec = spec_file(
+        &dir,
+        &format!(
+            r#"(scene: "{}", length: steps(30),
+                axes: [field("effects.restitution", [0.5, 1.0]), seed([1, 2]),
+                       field("spawn.radius", [(0.08, 0.08)]),
+                       field("spawn.placement", ["lattice"])])"#,
+            gas1k()
+        ),
+    );
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    successful(&["sweep", "plan", &spec, "--out", out]);
+    successful(&["sweep", "run", out, "--jobs", "2"]);
+    // Two distinct scenes, the restitution's: tasks 0 and 1 share scenes/0.ron.
+    let scene = std::fs::read_to_string(dir.join("out/scenes/0.ron")).unwrap();
+    assert!(scene.contains("restitution: 0.5,"), "{scene}");
+    assert!(scene.contains("placement: lattice"), "{scene}");
+    assert!(!dir.join("out/scenes/2.ron").exists());
+    let merged: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/merged.json")).unwrap())
+            .unwrap();
+    let task = &merged[1]["task"];
+    assert_eq!(task["fields"]["effects.restitution"].as_f64(), Some(0.5));
+    assert_eq!(task["seed"].as_u64(), Some(2));
+    let own = dir.join("out/scenes/0.ron");
+    let direct = run_report(
+        "sweep",
+        "field-direct",
+        &[
+            "run",
+            "--scene",
+            own.to_str().unwrap(),
+            "--seed",
+            "2",
+            "--steps",
+            "30",
+        ],
+    );
+    assert_eq!(
+        without_timings(merged[1]["report"].clone()),
+        without_timings(direct)
+    );
+    // Half the restitution loses energy the elastic tasks keep.
+    let drift = |row: usize| merged[row]["report"]["energy_drift"].as_f64().unwrap();
+    assert!(
+        drift(1) < -0.01 && drift(3).abs() < 1e-6,
+        "{} {}",
+        drift(1),
+        drift(3)
+    );
+    for (axis, expected) in [
+        (
+            r#"field("effects.bounciness", [1.0])"#,
+            "`effects` has no field `bounciness`",
+        ),
+        (
+            r#"field("effects.restitution", [-2.0])"#,
+            "effects.restitution",
+        ),
+        (
+            r#"field("effects.restitution", ["high"])"#,
+            "setting effects.restitution",
+        ),
+        (
+            r#"field("drop.rate", [1.0])"#,
+            "`drop` is not set in the scene",
+        ),
+        (r#"field("circles.3.radius", [1.0])"#, "is a list of 0"),
+    ] {
+        let spec = spec_file(
+            &dir,
+            &format!(
+                r#"(scene: "{}", length: steps(5), axes: [{axis}])"#,
+                gas1k()
+            ),
+        );
+        let other = dir.join("refused");
+        let refused = moving_circles(&["sweep", "plan", &spec, "--out", other.to_str().unwrap()]);
+        assert!(!refused.status.success(), "{axis}");
+        assert!(
+            stderr(&refused).contains(expected),
+            "{axis}: {}",
+            stderr(&refused)
+        );
+        assert!(
+            !other.join("spec.ron").exists(),
+            "no plan of a refused spec"
+        );
+        let _ = std::fs::remove_dir_all(other);
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_task_killed_at_any_moment_loses_nothing_and_its_rerun_gives_the_same_result() {
+    let dir = scratch_dir("sweep", "killed");
+    let spec = spec_file(
+        &dir,
+        &format!(
+            r#"(scene: "{}", length: steps(1500), axes: [solver(["soft=4"])])"#,
+            gas1k()
+        ),
+    );
+    let [killed, whole] = ["killed", "whole"].map(|name| dir.join(name));
+    for out in [&killed, &whole] {
+        successful(&["sweep", "plan", &spec, "--out", out.to_str().unwrap()]);
+    }
+    successful(&["sweep", "task", whole.to_str().unwrap(), "--index", "0"]);
+    let signal = |child: &std::process::Child, name: &str| {
+        let pid = child.id().to_string();
+        std::process::Command::new("kill")
+            .args([name, &pid])
+            .status()
+            .unwrap();
+    };
+    let task = || {
+        command(&["sweep", "task", killed.to_str().unwrap(), "--index", "0"])
+            .spawn()
+            .unwrap()
+    };
+    // Killed while stepping, with nothing saved yet.
+    let mut child = task();
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, "-KILL");
+    child.wait().unwrap();
+    // Stopped, then killed a few milliseconds later: while its checkpoint is written, or
+    // after; whichever it was, the folder holds a whole checkpoint or none.
+    let mut child = task();
+    std::thread::sleep(Duration::from_millis(2000));
+    signal(&child, "-TERM");
+    std::thread::sleep(Duration::from_millis(3));
+    signal(&child, "-KILL");
+    child.wait().unwrap();
+    assert!(
+        !killed.join("results/0.json").exists(),
+        "no result of a killed task"
+    );
+    // Resumed from whatever was saved, and killed again while it goes on.
+    let mut child = task();
+    std::thread::sleep(Duration::from_millis(1000));
+    signal(&child, "-KILL");
+    child.wait().unwrap();
+    successful(&["sweep", "task", killed.to_str().unwrap(), "--index", "0"]);
+    let [a, b] = [&killed, &whole].map(|out| read_report(&out.join("results/0.json")));
+    assert_eq!(without_timings(a), without_timings(b));
+    let status = successful(&["sweep", "status", killed.to_str().unwrap()]);
+    assert!(stdout(&status).contains("1 done"), "{}", stdout(&status));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn an_eos_sweep_draws_the_mean_z_of_each_area_fraction_over_its_seeds() {
+    let dir = scratch_dir("sweep", "eos");
+    let scene = format!("{}/assets/scenes/eos_box.ron", env!("CARGO_MANIFEST_DIR"));
+    let spec = spec_file(
+        &dir,
+        &format!(
+            r#"(scene: "{scene}", length: steps(40),
+                axes: [area_fraction([0.2, 0.4]), seed([1, 2])], figure: Some(eos))"#
+        ),
+    );
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    successful(&["sweep", "plan", &spec, "--out", out]);
+    let ran = successful(&["sweep", "run", out, "--jobs", "2"]);
+    assert!(
+        stdout(&ran).contains("equation of state of 2 area fractions"),
+        "{}",
+        stdout(&ran)
+    );
+    let merged: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/merged.json")).unwrap())
+            .unwrap();
+    let z = |row: usize| merged[row]["report"]["z"].as_f64().unwrap();
+    // The product puts the seeds of 0.4 at rows 2 and 3; the figure's point is their mean.
+    let mean = (z(2) + z(3)) / 2.0;
+    assert!(
+        stdout(&ran).contains(&format!("area fraction 0.4: z {mean:.5} ± ")),
+        "the mean of {} and {}: {}",
+        z(2),
+        z(3),
+        stdout(&ran)
+    );
+    let drawing = std::fs::read_to_string(dir.join("out/eos.svg")).unwrap();
+    assert!(drawing.starts_with("<svg"), "{}", &drawing[..80]);
+    assert!(std::fs::metadata(dir.join("out/eos.png")).unwrap().len() > 1000);
+    assert!(mean > 1.5, "Z at 0.4 is about 2.5, not {mean}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn hostile_specs_are_refused_naming_the_field() {
     let scene = gas1k();
     let cases = [
@@ -153,6 +347,15 @@ fn hostile_specs_are_refused_naming_the_field() {
         (r#"slurm: (time_limit: "soon")"#, "slurm.time_limit"),
         (r#"slurm: (concurrency: 0)"#, "slurm.concurrency"),
         (r#"colour: "red""#, "colour"),
+        (r#"axes: [seed([1])], figure: Some(eos)"#, "figure: `eos`"),
+        (
+            r#"axes: [field("effects restitution", [1.0])]"#,
+            "is not a field's path",
+        ),
+        (
+            r#"axes: [field("dt", [0.1]), field("dt", [0.2])]"#,
+            "field \"dt\" is already axes[0]",
+        ),
     ];
     // A billion tasks: three axes of a thousand values.
     let thousand = |f: &dyn Fn(usize) -> String| (0..1000).map(f).collect::<Vec<_>>().join(",");
@@ -209,4 +412,17 @@ fn a_folder_holding_another_sweeps_plan_is_refused() {
         stderr(&bad_index)
     );
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn the_specs_that_ship_are_valid_and_name_scenes_that_exist() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/sweeps");
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let spec = SweepSpec::read(&path).unwrap();
+        assert!(dir.join(&spec.scene).is_file(), "{path:?}: {:?}", spec.scene);
+        seen += 1;
+    }
+    assert!(seen >= 2);
 }

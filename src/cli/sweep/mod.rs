@@ -10,10 +10,15 @@
 //! task's settings, so a task stopped by a signal writes a checkpoint and the next try goes on
 //! from it to the same bits.
 
+mod fields;
+mod merge;
 pub mod spec;
 
+pub use merge::merge;
+
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 
@@ -80,7 +85,8 @@ impl Plan {
         let spec = SweepSpec::read(&spec_path).map_err(anyhow::Error::msg)?;
         // The task list is the spec's, expanded again: the file is for people and Slurm's
         // logs, and cannot disagree with the spec it came from.
-        let tasks = spec.tasks();
+        let mut tasks = spec.tasks();
+        fields::name_scenes(&mut tasks);
         Ok(Self {
             folder,
             spec,
@@ -121,11 +127,20 @@ pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
             spec_path.display()
         );
     }
-    for sub in ["results", "failed", "work", "logs"] {
+    for sub in ["results", "failed", "work", "logs", "scenes"] {
         let path = out.join(sub);
         std::fs::create_dir_all(&path).with_context(|| format!("creating {}", path.display()))?;
     }
-    let tasks = spec.tasks();
+    let mut tasks = spec.tasks();
+    if tasks.iter().any(|t| !t.fields.is_empty()) {
+        let file = std::fs::File::open(&spec.scene)
+            .with_context(|| format!("{}", spec.scene.display()))?;
+        let text = read_limited(file, crate::tools::io::MAX_SCENE_BYTES)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", spec.scene.display()))?;
+        let base = Scene::parse(&text, &spec.scene.display().to_string())?;
+        fields::write_scenes(&base, &mut tasks, out)
+            .with_context(|| format!("{}", spec_path.display()))?;
+    }
     let mut lines = String::new();
     for task in &tasks {
         lines.push_str(&serde_json::to_string(task).context("a task as JSON")?);
@@ -243,7 +258,10 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
         SpecLength::Seconds(seconds) => Length::Seconds(seconds),
     };
     let mut options = RunOptions {
-        input: Input::Scene(plan.spec.scene.clone()),
+        input: Input::Scene(match &task.scene {
+            Some(own) => folder.dir.join(own),
+            None => plan.spec.scene.clone(),
+        }),
         solver: task
             .solver
             .as_deref()
@@ -295,7 +313,7 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
 }
 
 /// `sweep run`: every task without a result, `jobs` at a time, each a `sweep task` process
-/// writing into `logs/`.
+/// writing into `logs/`; then, every task done, [`merge`].
 pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
     if jobs == 0 {
         bail!("--jobs must be at least 1");
@@ -311,10 +329,16 @@ pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
             .expect("valid template"),
     );
     let mut queue = pending.iter().copied();
-    let mut running: Vec<(usize, Child)> = Vec::new();
+    // Each task is waited for on a thread of its own, which says when it ends: the next one
+    // starts at once, with no polling.
+    type Ended = (usize, std::io::Result<ExitStatus>, Duration);
+    let (ended, ends) = std::sync::mpsc::channel::<Ended>();
+    let started = Instant::now();
+    let mut own_time = Duration::ZERO;
+    let mut running = 0;
     let mut failed = Vec::new();
     loop {
-        while running.len() < jobs
+        while running < jobs
             && let Some(index) = queue.next()
         {
             let log = std::fs::OpenOptions::new()
@@ -322,7 +346,8 @@ pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
                 .append(true)
                 .open(folder.log(index))
                 .with_context(|| format!("opening {}", folder.log(index).display()))?;
-            let child = Command::new(&program)
+            let start = Instant::now();
+            let mut child = Command::new(&program)
                 .args(["sweep", "task"])
                 .arg(dir)
                 .args(["--index", &index.to_string()])
@@ -331,33 +356,38 @@ pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
                 .stderr(log)
                 .spawn()
                 .context("starting a task")?;
-            running.push((index, child));
+            let ended = ended.clone();
+            std::thread::spawn(move || {
+                let status = child.wait();
+                ended.send((index, status, start.elapsed()))
+            });
+            running += 1;
         }
-        if running.is_empty() {
+        if running == 0 {
             break;
         }
-        let mut k = 0;
-        while k < running.len() {
-            match running[k].1.try_wait()? {
-                Some(status) => {
-                    let (index, _) = running.swap_remove(k);
-                    if !status.success() {
-                        failed.push(index);
-                        bar.set_message(format!("{} failed", failed.len()));
-                    }
-                    bar.inc(1);
-                }
-                None => k += 1,
-            }
+        let (index, status, took) = ends.recv().expect("a waiting thread per running task");
+        running -= 1;
+        own_time += took;
+        if !status
+            .with_context(|| format!("waiting for task {index}"))?
+            .success()
+        {
+            failed.push(index);
+            bar.set_message(format!("{} failed", failed.len()));
         }
-        std::thread::sleep(std::time::Duration::from_millis(20));
+        bar.inc(1);
     }
     bar.finish_and_clear();
     let done = pending.len() - failed.len();
+    let wall = started.elapsed().as_secs_f64();
+    let per_job = own_time.as_secs_f64() / jobs as f64;
     say(format_args!(
-        "{done} of {} tasks done here ({} done before)",
+        "{done} of {} tasks done here ({} done before) in {wall:.1} s; the tasks took \
+         {per_job:.1} s a job, from start to end: {:+.1} % in between",
         pending.len(),
-        plan.tasks.len() - pending.len()
+        plan.tasks.len() - pending.len(),
+        100.0 * (wall / per_job.max(f64::MIN_POSITIVE) - 1.0)
     ));
     if !failed.is_empty() {
         failed.sort_unstable();
@@ -366,7 +396,8 @@ pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
             dir.display()
         );
     }
-    Ok(())
+    // Every task has its result: the merge (and its figure) is the sweep's outcome.
+    merge(dir)
 }
 
 /// `sweep status`: how many tasks are done, started (a checkpoint, or running), failed (with
@@ -398,114 +429,4 @@ pub fn status(dir: &Path) -> anyhow::Result<()> {
         say(format_args!("  task {i} failed: {why}"));
     }
     Ok(())
-}
-
-/// `sweep merge`: every task's settings and report as one row, into `merged.csv` and
-/// `merged.json` in the sweep's folder; every task must be done.
-pub fn merge(dir: &Path) -> anyhow::Result<()> {
-    let plan = Plan::open(dir)?;
-    let folder = &plan.folder;
-    let missing: Vec<usize> = (0..plan.tasks.len())
-        .filter(|&i| !folder.result(i).exists())
-        .collect();
-    if !missing.is_empty() {
-        let shown: Vec<_> = missing.iter().take(20).collect();
-        bail!(
-            "{} of {} tasks have no result yet (tasks {shown:?}{}): `moving_circles sweep status \
-             {}`",
-            missing.len(),
-            plan.tasks.len(),
-            if missing.len() > shown.len() {
-                ", ..."
-            } else {
-                ""
-            },
-            dir.display()
-        );
-    }
-    let mut rows = Vec::new();
-    for task in &plan.tasks {
-        let path = folder.result(task.index);
-        let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
-        let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
-        let report: serde_json::Value = serde_json::from_str(&text)
-            .ok()
-            .filter(serde_json::Value::is_object)
-            .with_context(|| format!("{}: not a run report", path.display()))?;
-        rows.push(serde_json::json!({ "task": task, "report": report }));
-    }
-    let json = serde_json::to_string_pretty(&rows)?;
-    let csv = csv_of(&rows)?;
-    let [csv_path, json_path] = ["merged.csv", "merged.json"].map(|name| dir.join(name));
-    write_atomically(&csv_path, csv.as_bytes())
-        .with_context(|| format!("writing {}", csv_path.display()))?;
-    write_atomically(&json_path, json.as_bytes())
-        .with_context(|| format!("writing {}", json_path.display()))?;
-    say(format_args!(
-        "merged {} tasks into {} and {}",
-        rows.len(),
-        csv_path.display(),
-        json_path.display()
-    ));
-    Ok(())
-}
-
-/// The rows as CSV: the task's settings (`task`, `task_solver`, ...) then the report's fields,
-/// arrays of numbers split into `name_0`, `name_1`, ..., other arrays as their items with
-/// spaces between, objects as a column for each of their fields.
-fn csv_of(rows: &[serde_json::Value]) -> anyhow::Result<String> {
-    let flat: Vec<Vec<(String, String)>> = rows
-        .iter()
-        .map(|row| {
-            let mut cells = flatten(&row["task"], "task_");
-            if let Some(k) = cells.iter().position(|(k, _)| k == "task_index") {
-                let (_, index) = cells.remove(k);
-                cells.insert(0, ("task".into(), index));
-            }
-            cells.extend(flatten(&row["report"], ""));
-            cells
-        })
-        .collect();
-    let mut writer = csv::Writer::from_writer(Vec::new());
-    if let Some(first) = flat.first() {
-        writer.write_record(first.iter().map(|(k, _)| k))?;
-    }
-    for row in &flat {
-        writer.write_record(row.iter().map(|(_, v)| v))?;
-    }
-    Ok(String::from_utf8(writer.into_inner()?)?)
-}
-
-/// An object's fields as `(column, text)`, each column named `prefix` and its key.
-fn flatten(object: &serde_json::Value, prefix: &str) -> Vec<(String, String)> {
-    let mut out = Vec::new();
-    let Some(object) = object.as_object() else {
-        return out;
-    };
-    for (key, value) in object {
-        let key = format!("{prefix}{key}");
-        match value {
-            serde_json::Value::Array(items) if items.iter().all(|v| v.is_number()) => {
-                for (k, item) in items.iter().enumerate() {
-                    out.push((format!("{key}_{k}"), text_of(item)));
-                }
-            }
-            serde_json::Value::Array(items) => {
-                let words: Vec<String> = items.iter().map(text_of).collect();
-                out.push((key.clone(), words.join(" ")));
-            }
-            serde_json::Value::Object(_) => out.extend(flatten(value, &format!("{key}_"))),
-            _ => out.push((key, text_of(value))),
-        }
-    }
-    out
-}
-
-/// A JSON value as a CSV cell.
-fn text_of(value: &serde_json::Value) -> String {
-    match value {
-        serde_json::Value::Null => String::new(),
-        serde_json::Value::String(s) => s.clone(),
-        other => other.to_string(),
-    }
 }

@@ -1,7 +1,9 @@
 //! A sweep spec (RON): the scene every task starts from, the axes its tasks vary (solver,
-//! step, seed, area fraction, length), how they combine, and how the Slurm array runs them;
-//! checked like a scene, each error naming its field, and expanded into [`Task`]s.
+//! step, seed, area fraction, length, any scene field), how they combine, the figure of the
+//! merged results, and how the Slurm array runs them; checked like a scene, each error naming
+//! its field, and expanded into [`Task`]s.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -33,6 +35,19 @@ pub struct SweepSpec {
     /// How Slurm runs the array.
     #[serde(default)]
     pub slurm: SlurmSettings,
+    /// The figure `merge` draws, if any.
+    #[serde(default)]
+    pub figure: Option<SweepFigure>,
+}
+
+/// A figure of the merged results.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SweepFigure {
+    /// The equation of state: the report's `z` against the `area_fraction` axis, the mean over
+    /// the tasks of each area fraction (the seeds) with its standard error, over Henderson's
+    /// and Liu's curves (`eos.svg`, `eos.png`).
+    Eos,
 }
 
 /// How long a task runs.
@@ -59,6 +74,10 @@ pub enum Axis {
     AreaFraction(Vec<f64>),
     /// Run lengths in steps.
     Steps(Vec<u64>),
+    /// Any field of the scene by its path (`effects.restitution`, `arena.size`,
+    /// `soft.hertz`, `spawn.radius`), with values as the scene file would give them, an
+    /// enum's variant as a string (`"lattice"`). Each task gets a scene file of its own.
+    Field(String, Vec<serde_json::Value>),
 }
 
 impl Axis {
@@ -70,6 +89,15 @@ impl Axis {
             Self::Seed(_) => "seed",
             Self::AreaFraction(_) => "area_fraction",
             Self::Steps(_) => "steps",
+            Self::Field(..) => "field",
+        }
+    }
+
+    /// What it sets: its name, or a field's path.
+    fn sets(&self) -> String {
+        match self {
+            Self::Field(path, _) => format!("field {path:?}"),
+            other => format!("`{}`", other.name()),
         }
     }
 
@@ -79,6 +107,7 @@ impl Axis {
             Self::Solver(v) => v.len(),
             Self::Dt(v) | Self::AreaFraction(v) => v.len(),
             Self::Seed(v) | Self::Steps(v) => v.len(),
+            Self::Field(_, v) => v.len(),
         }
     }
 
@@ -95,6 +124,9 @@ impl Axis {
             Self::Seed(v) => task.seed = Some(v[k]),
             Self::AreaFraction(v) => task.area_fraction = Some(v[k]),
             Self::Steps(v) => task.length = SpecLength::Steps(v[k]),
+            Self::Field(path, v) => {
+                task.fields.insert(path.clone(), v[k].clone());
+            }
         }
     }
 
@@ -133,6 +165,20 @@ impl Axis {
                 }
             }
             Self::Steps(v) => check_steps(v, &field)?,
+            Self::Field(path, _) => {
+                let word = |w: &str| {
+                    !w.is_empty() && w.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
+                };
+                if !path.split('.').all(word) {
+                    return Err(FieldError::new(
+                        field,
+                        format!(
+                            "{path:?} is not a field's path: names (or list positions) joined by \
+                             dots, such as \"effects.restitution\""
+                        ),
+                    ));
+                }
+            }
             Self::Seed(_) => {}
         }
         Ok(())
@@ -201,6 +247,12 @@ pub struct Task {
     pub area_fraction: Option<f64>,
     /// How long it runs.
     pub length: SpecLength,
+    /// The scene fields its `field` axes set, by path.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub fields: BTreeMap<String, serde_json::Value>,
+    /// Its own scene file in the sweep's folder (`scenes/K.ron`), when it sets fields.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene: Option<String>,
 }
 
 impl SweepSpec {
@@ -235,10 +287,10 @@ impl SweepSpec {
         }
         for (k, axis) in self.axes.iter().enumerate() {
             axis.check(&format!("axes[{k}]"))?;
-            if let Some(j) = self.axes[..k].iter().position(|a| a.name() == axis.name()) {
+            if let Some(j) = self.axes[..k].iter().position(|a| a.sets() == axis.sets()) {
                 return Err(FieldError::new(
                     format!("axes[{k}]"),
-                    format!("`{}` is already axes[{j}]", axis.name()),
+                    format!("{} is already axes[{j}]", axis.sets()),
                 ));
             }
         }
@@ -261,6 +313,14 @@ impl SweepSpec {
             return Err(FieldError::new(
                 "axes",
                 format!("make {count} tasks, more than the {MAX_TASKS} a sweep may have"),
+            ));
+        }
+        if self.figure == Some(SweepFigure::Eos)
+            && !self.axes.iter().any(|a| matches!(a, Axis::AreaFraction(_)))
+        {
+            return Err(FieldError::new(
+                "figure",
+                "`eos` draws z against area fraction: the spec needs an `area_fraction` axis",
             ));
         }
         let slurm = &self.slurm;
@@ -302,6 +362,8 @@ impl SweepSpec {
                     seed: None,
                     area_fraction: None,
                     length: self.length,
+                    fields: BTreeMap::new(),
+                    scene: None,
                 };
                 let mut rest = index;
                 // The last axis varies fastest.

@@ -22,8 +22,13 @@ const LIU: RGBColor = RGBColor(215, 48, 39);
 const HENDERSON: RGBColor = RGBColor(120, 120, 120);
 const LITERATURE: RGBColor = RGBColor(35, 139, 69);
 
-/// The figure of `points`, all of one `n`.
-pub struct EosFigure<'a>(pub &'a [EosPoint]);
+/// The figure of `points`, their error bars said by `bars` (e.g. "block error bars").
+pub struct EosFigure<'a> {
+    /// The measured points.
+    pub points: &'a [EosPoint],
+    /// What the error bars are, for the legend.
+    pub bars: &'a str,
+}
 
 impl Figure for EosFigure<'_> {
     fn size(&self) -> (u32, u32) {
@@ -32,16 +37,23 @@ impl Figure for EosFigure<'_> {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let (left, right) = root.split_horizontally(760);
-        z_panel(&left, self.0)?;
-        deviation_panel(&right, self.0)
+        z_panel(&left, self.points, self.bars)?;
+        deviation_panel(&right, self.points)
     }
 }
 
 fn z_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     points: &[EosPoint],
+    bars: &str,
 ) -> Result<(), String> {
-    let n = points.first().map_or(0, |p| p.n);
+    let lo = points.iter().map(|p| p.n).min().unwrap_or(0);
+    let hi = points.iter().map(|p| p.n).max().unwrap_or(0);
+    let n = if lo == hi {
+        lo.to_string()
+    } else {
+        format!("{lo} to {hi}")
+    };
     let top = points
         .iter()
         .map(|p| p.z + p.z_error)
@@ -103,7 +115,7 @@ fn z_panel<DB: DrawingBackend>(
                 .map(|p| Circle::new((p.area_fraction, p.z), 4, MEASURED.filled())),
         )
         .map_err(err)?
-        .label("measured (exact), block error bars")
+        .label(format!("measured (exact), {bars}"))
         .legend(|(x, y)| Circle::new((x + 12, y), 4, MEASURED.filled()));
     chart
         .configure_series_labels()

@@ -4,7 +4,7 @@
 //! unknown field. Checking the values is `check`'s job.
 
 use bevy::math::DVec2;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::base::arena::Boundary;
 use crate::base::config::{DropConfig, Effects, MassModel, SoftConfig, Solver, SpawnConfig};
@@ -12,7 +12,7 @@ use crate::base::error::InputError;
 use crate::tools::io::{BYTE_ORDER_MARK, BYTE_ORDER_MARK_MESSAGE};
 
 /// The arena as a scene file gives it.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ArenaSpec {
     /// Width and height.
@@ -34,7 +34,7 @@ impl Default for ArenaSpec {
 }
 
 /// One circle placed exactly.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CircleSpec {
     /// Centre.
@@ -61,7 +61,7 @@ pub struct CircleSpec {
 }
 
 /// A scene file. Every field has a default, so a file names only what it changes.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Scene {
     /// Short name.

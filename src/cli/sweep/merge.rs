@@ -1,0 +1,198 @@
+//! `sweep merge`: every finished task's settings and report as one row of `merged.csv` and
+//! `merged.json`, and the figure the spec asks for.
+
+use std::path::Path;
+
+use anyhow::{Context, bail};
+
+use super::Plan;
+use super::spec::SweepFigure;
+use crate::tools::eos::EosPoint;
+use crate::tools::eos::plot::EosFigure;
+use crate::tools::eos::theory::{henderson_z, liu_z};
+use crate::tools::figure::{png, svg};
+use crate::tools::io::{read_limited, say, write_atomically};
+
+/// `sweep merge`: every task's settings and report as one row, into `merged.csv` and
+/// `merged.json` in the sweep's folder; every task must be done.
+pub fn merge(dir: &Path) -> anyhow::Result<()> {
+    let plan = Plan::open(dir)?;
+    let folder = &plan.folder;
+    let missing: Vec<usize> = (0..plan.tasks.len())
+        .filter(|&i| !folder.result(i).exists())
+        .collect();
+    if !missing.is_empty() {
+        let shown: Vec<_> = missing.iter().take(20).collect();
+        bail!(
+            "{} of {} tasks have no result yet (tasks {shown:?}{}): `moving_circles sweep status \
+             {}`",
+            missing.len(),
+            plan.tasks.len(),
+            if missing.len() > shown.len() {
+                ", ..."
+            } else {
+                ""
+            },
+            dir.display()
+        );
+    }
+    let mut rows = Vec::new();
+    for task in &plan.tasks {
+        let path = folder.result(task.index);
+        let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
+        let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
+        let report: serde_json::Value = serde_json::from_str(&text)
+            .ok()
+            .filter(serde_json::Value::is_object)
+            .with_context(|| format!("{}: not a run report", path.display()))?;
+        rows.push(serde_json::json!({ "task": task, "report": report }));
+    }
+    let json = serde_json::to_string_pretty(&rows)?;
+    let csv = csv_of(&rows)?;
+    let [csv_path, json_path] = ["merged.csv", "merged.json"].map(|name| dir.join(name));
+    write_atomically(&csv_path, csv.as_bytes())
+        .with_context(|| format!("writing {}", csv_path.display()))?;
+    write_atomically(&json_path, json.as_bytes())
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    say(format_args!(
+        "merged {} tasks into {} and {}",
+        rows.len(),
+        csv_path.display(),
+        json_path.display()
+    ));
+    if plan.spec.figure == Some(SweepFigure::Eos) {
+        eos_figure(&rows, dir)?;
+    }
+    Ok(())
+}
+
+/// The equation of state of the merged rows: for each area fraction, the mean of the tasks'
+/// `z` and its standard error, drawn as the `eos` command draws its points, into `eos.svg`
+/// and `eos.png` in `dir`.
+fn eos_figure(rows: &[serde_json::Value], dir: &Path) -> anyhow::Result<()> {
+    let mut by_fraction: Vec<(f64, Vec<&serde_json::Value>)> = Vec::new();
+    for row in rows {
+        let Some(phi) = row["task"]["area_fraction"].as_f64() else {
+            continue;
+        };
+        match by_fraction.iter_mut().find(|(f, _)| *f == phi) {
+            Some((_, group)) => group.push(&row["report"]),
+            None => by_fraction.push((phi, vec![&row["report"]])),
+        }
+    }
+    by_fraction.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut points = Vec::new();
+    for (phi, reports) in by_fraction {
+        let zs: Vec<f64> = reports.iter().filter_map(|r| r["z"].as_f64()).collect();
+        if zs.is_empty() {
+            bail!("no task at area fraction {phi} measured z (the report's `z`)");
+        }
+        let k = zs.len() as f64;
+        let z = zs.iter().sum::<f64>() / k;
+        let spread = zs.iter().map(|x| (x - z).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
+        let sum = |field: &str| {
+            reports
+                .iter()
+                .filter_map(|r| r[field].as_f64())
+                .sum::<f64>()
+        };
+        let liu = liu_z(phi);
+        let z_error = (spread / k).sqrt();
+        say(format_args!(
+            "area fraction {phi}: z {z:.5} ± {z_error:.5} over {} tasks (Liu {liu:.5})",
+            zs.len()
+        ));
+        points.push(EosPoint {
+            area_fraction: phi,
+            n: (sum("n") / reports.len() as f64).round() as usize,
+            z,
+            z_error,
+            henderson: henderson_z(phi),
+            liu,
+            vs_liu: z / liu - 1.0,
+            blocks: zs.len(),
+            collisions: sum("pair_collisions") as u64,
+            sim_seconds: sum("sim_seconds"),
+            speed_ks: f64::NAN,
+            speed_ks_critical: f64::NAN,
+            wall_seconds: sum("wall_seconds"),
+        });
+    }
+    let figure = EosFigure {
+        points: &points,
+        bars: "standard error over seeds",
+    };
+    let [vector, picture] = ["eos.svg", "eos.png"].map(|name| dir.join(name));
+    let drawing = svg(&figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", vector.display()))?;
+    write_atomically(&vector, drawing.as_bytes())
+        .with_context(|| format!("writing {}", vector.display()))?;
+    let bytes = png(&figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", picture.display()))?;
+    write_atomically(&picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
+    say(format_args!(
+        "drew the equation of state of {} area fractions into {} and {}",
+        points.len(),
+        vector.display(),
+        picture.display()
+    ));
+    Ok(())
+}
+
+/// The rows as CSV: the task's settings (`task`, `task_solver`, ...) then the report's fields,
+/// arrays of numbers split into `name_0`, `name_1`, ..., other arrays as their items with
+/// spaces between, objects as a column for each of their fields.
+fn csv_of(rows: &[serde_json::Value]) -> anyhow::Result<String> {
+    let flat: Vec<Vec<(String, String)>> = rows
+        .iter()
+        .map(|row| {
+            let mut cells = flatten(&row["task"], "task_");
+            if let Some(k) = cells.iter().position(|(k, _)| k == "task_index") {
+                let (_, index) = cells.remove(k);
+                cells.insert(0, ("task".into(), index));
+            }
+            cells.extend(flatten(&row["report"], ""));
+            cells
+        })
+        .collect();
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    if let Some(first) = flat.first() {
+        writer.write_record(first.iter().map(|(k, _)| k))?;
+    }
+    for row in &flat {
+        writer.write_record(row.iter().map(|(_, v)| v))?;
+    }
+    Ok(String::from_utf8(writer.into_inner()?)?)
+}
+
+/// An object's fields as `(column, text)`, each column named `prefix` and its key.
+fn flatten(object: &serde_json::Value, prefix: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let Some(object) = object.as_object() else {
+        return out;
+    };
+    for (key, value) in object {
+        let key = format!("{prefix}{key}");
+        match value {
+            serde_json::Value::Array(items) if items.iter().all(|v| v.is_number()) => {
+                for (k, item) in items.iter().enumerate() {
+                    out.push((format!("{key}_{k}"), text_of(item)));
+                }
+            }
+            serde_json::Value::Array(items) => {
+                let words: Vec<String> = items.iter().map(text_of).collect();
+                out.push((key.clone(), words.join(" ")));
+            }
+            serde_json::Value::Object(_) => out.extend(flatten(value, &format!("{key}_"))),
+            _ => out.push((key, text_of(value))),
+        }
+    }
+    out
+}
+
+/// A JSON value as a CSV cell.
+fn text_of(value: &serde_json::Value) -> String {
+    match value {
+        serde_json::Value::Null => String::new(),
+        serde_json::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
