@@ -39,7 +39,8 @@ fn each_task_of_a_sweep_reports_what_run_reports_for_its_settings() {
     let spec = spec_file(
         &dir,
         &format!(
-            r#"(scene: "{}", length: steps(20), axes: [solver(["discrete", "soft=4"]), seed([1, 2])])"#,
+            r#"(scene: "{}", length: steps(20), axes: [solver(["discrete", "soft=4"]), seed([1, 2])],
+                dump: true)"#,
             gas1k()
         ),
     );
@@ -59,6 +60,7 @@ fn each_task_of_a_sweep_reports_what_run_reports_for_its_settings() {
         (task["solver"].as_str(), task["seed"].as_u64()),
         (Some("soft=4"), Some(2))
     );
+    let dump = dir.join("direct.txt");
     let direct = run_report(
         "sweep",
         "direct",
@@ -72,7 +74,14 @@ fn each_task_of_a_sweep_reports_what_run_reports_for_its_settings() {
             "2",
             "--steps",
             "20",
+            "--dump",
+            dump.to_str().unwrap(),
         ],
+    );
+    assert_eq!(
+        std::fs::read(dir.join("out/results/3.dump.txt")).unwrap(),
+        std::fs::read(&dump).unwrap(),
+        "the task's final state is the run's"
     );
     assert_eq!(
         without_timings(rows[3]["report"].clone()),
@@ -421,7 +430,11 @@ fn the_specs_that_ship_are_valid_and_name_scenes_that_exist() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         let spec = SweepSpec::read(&path).unwrap();
-        assert!(dir.join(&spec.scene).is_file(), "{path:?}: {:?}", spec.scene);
+        assert!(
+            dir.join(&spec.scene).is_file(),
+            "{path:?}: {:?}",
+            spec.scene
+        );
         seen += 1;
     }
     assert!(seen >= 2);

@@ -55,6 +55,12 @@ impl Folder {
     fn report(&self, index: usize) -> PathBuf {
         self.dir.join("work").join(format!("{index}.report.json"))
     }
+    fn dump(&self, index: usize) -> PathBuf {
+        self.dir.join("work").join(format!("{index}.dump.txt"))
+    }
+    fn kept_dump(&self, index: usize) -> PathBuf {
+        self.dir.join("results").join(format!("{index}.dump.txt"))
+    }
     fn log(&self, index: usize) -> PathBuf {
         self.dir.join("logs").join(format!("{index}.log"))
     }
@@ -236,6 +242,12 @@ pub fn task(dir: &Path, index: Option<usize>) -> anyhow::Result<Finished> {
     let outcome = run_task(&plan, task);
     match &outcome {
         Ok(Finished::Completed) => {
+            // The dump first: a task with its report in `results/` has everything there.
+            if plan.spec.dump {
+                let kept = folder.kept_dump(index);
+                std::fs::rename(folder.dump(index), &kept)
+                    .with_context(|| format!("putting {} in place", kept.display()))?;
+            }
             std::fs::rename(folder.report(index), &result)
                 .with_context(|| format!("putting {} in place", result.display()))?;
             let _ = std::fs::remove_file(folder.checkpoint(index));
@@ -275,7 +287,7 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
         placement: None,
         area_fraction: task.area_fraction,
         report: Some(folder.report(task.index)),
-        dump: None,
+        dump: plan.spec.dump.then(|| folder.dump(task.index)),
         threads: Some(1),
         vector: true,
         checkpoint: Some(checkpoint.clone()),

@@ -38,6 +38,10 @@ pub struct SweepSpec {
     /// The figure `merge` draws, if any.
     #[serde(default)]
     pub figure: Option<SweepFigure>,
+    /// Whether each task also keeps its final state (`results/I.dump.txt`, as `run --dump`
+    /// writes it); every task keeps its report.
+    #[serde(default)]
+    pub dump: bool,
 }
 
 /// A figure of the merged results.
