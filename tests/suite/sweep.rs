@@ -102,21 +102,34 @@ fn each_task_of_a_sweep_reports_what_run_reports_for_its_settings() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-#[test]
-fn a_task_stopped_by_sigterm_goes_on_from_its_checkpoint_to_the_same_result() {
-    let dir = scratch_dir("sweep", "resume");
+/// Plans a sweep of one long `soft` task into `dir/tried` and `dir/whole`, and runs the
+/// second's task whole; the two folders.
+fn long_task_twice(dir: &Path) -> [std::path::PathBuf; 2] {
     let spec = spec_file(
-        &dir,
+        dir,
         &format!(
             r#"(scene: "{}", length: steps(1500), axes: [solver(["soft=4"])])"#,
             gas1k()
         ),
     );
-    let [stopped, whole] = ["stopped", "whole"].map(|name| dir.join(name));
-    for out in [&stopped, &whole] {
+    let folders = ["tried", "whole"].map(|name| dir.join(name));
+    for out in &folders {
         successful(&["sweep", "plan", &spec, "--out", out.to_str().unwrap()]);
     }
-    successful(&["sweep", "task", whole.to_str().unwrap(), "--index", "0"]);
+    successful(&[
+        "sweep",
+        "task",
+        folders[1].to_str().unwrap(),
+        "--index",
+        "0",
+    ]);
+    folders
+}
+
+#[test]
+fn a_task_stopped_by_sigterm_goes_on_from_its_checkpoint_to_the_same_result() {
+    let dir = scratch_dir("sweep", "resume");
+    let [stopped, whole] = long_task_twice(&dir);
     let mut child = command(&["sweep", "task", stopped.to_str().unwrap()])
         .env("SLURM_ARRAY_TASK_ID", "0")
         .spawn()
@@ -247,18 +260,7 @@ fn a_field_axis_runs_each_task_on_its_own_scene_file_and_bad_fields_are_refused(
 #[test]
 fn a_task_killed_at_any_moment_loses_nothing_and_its_rerun_gives_the_same_result() {
     let dir = scratch_dir("sweep", "killed");
-    let spec = spec_file(
-        &dir,
-        &format!(
-            r#"(scene: "{}", length: steps(1500), axes: [solver(["soft=4"])])"#,
-            gas1k()
-        ),
-    );
-    let [killed, whole] = ["killed", "whole"].map(|name| dir.join(name));
-    for out in [&killed, &whole] {
-        successful(&["sweep", "plan", &spec, "--out", out.to_str().unwrap()]);
-    }
-    successful(&["sweep", "task", whole.to_str().unwrap(), "--index", "0"]);
+    let [killed, whole] = long_task_twice(&dir);
     let signal = |child: &std::process::Child, name: &str| {
         let pid = child.id().to_string();
         std::process::Command::new("kill")
