@@ -33,7 +33,7 @@ pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
         &points,
         &EosFigure {
             points: &points,
-            bars: "block error bars",
+            bars: "exact, block error bars",
         },
         out,
         "eos",

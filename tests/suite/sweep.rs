@@ -108,7 +108,7 @@ fn long_task_twice(dir: &Path) -> [std::path::PathBuf; 2] {
     let spec = spec_file(
         dir,
         &format!(
-            r#"(scene: "{}", length: steps(1500), axes: [solver(["soft=4"])])"#,
+            r#"(scene: "{}", length: steps(3000), axes: [solver(["soft=4"])])"#,
             gas1k()
         ),
     );
@@ -188,6 +188,16 @@ fn a_field_axis_runs_each_task_on_its_own_scene_file_and_bad_fields_are_refused(
     let task = &merged[1]["task"];
     assert_eq!(task["fields"]["effects.restitution"].as_f64(), Some(0.5));
     assert_eq!(task["seed"].as_u64(), Some(2));
+    let scenes: Vec<_> = (0..4).map(|k| merged[k]["task"]["scene"].clone()).collect();
+    assert_eq!(
+        scenes,
+        [
+            "scenes/0.ron",
+            "scenes/0.ron",
+            "scenes/1.ron",
+            "scenes/1.ron"
+        ]
+    );
     let own = dir.join("out/scenes/0.ron");
     let direct = run_report(
         "sweep",
@@ -295,7 +305,14 @@ fn a_task_killed_at_any_moment_loses_nothing_and_its_rerun_gives_the_same_result
     std::thread::sleep(Duration::from_millis(1000));
     signal(&child, "-KILL");
     child.wait().unwrap();
-    successful(&["sweep", "task", killed.to_str().unwrap(), "--index", "0"]);
+    let saved = killed.join("work/0.checkpoint").exists();
+    let last = successful(&["sweep", "task", killed.to_str().unwrap(), "--index", "0"]);
+    assert_eq!(
+        stdout(&last).contains("going on from"),
+        saved,
+        "a checkpoint left is gone on from: {}",
+        stdout(&last)
+    );
     let [a, b] = [&killed, &whole].map(|out| read_report(&out.join("results/0.json")));
     assert_eq!(without_timings(a), without_timings(b));
     let status = successful(&["sweep", "status", killed.to_str().unwrap()]);
@@ -364,8 +381,32 @@ fn hostile_specs_are_refused_naming_the_field() {
             "is not a field's path",
         ),
         (
-            r#"axes: [field("dt", [0.1]), field("dt", [0.2])]"#,
-            "field \"dt\" is already axes[0]",
+            r#"axes: [field("effects.drag", [0.1]), field("effects.drag", [0.2])]"#,
+            "field \"effects.drag\" is already axes[0]",
+        ),
+        (
+            r#"axes: [field("circles.00.radius", [1.0])]"#,
+            "is not a field's path",
+        ),
+        (
+            r#"axes: [field("spawn.seed", [4])]"#,
+            "set by the `seed` axis",
+        ),
+        (
+            r#"axes: [field("effects.restitution", [0.5, inf])]"#,
+            "axes[0].field[1]: inf is not a number",
+        ),
+        (
+            r#"axes: [seed([1, 2, 1])]"#,
+            "axes[0].seed[2]: repeats axes[0].seed[0]",
+        ),
+        (
+            r#"axes: [area_fraction([0.2]), seed([1])], figure: Some(eos)"#,
+            "a `seed` axis of two",
+        ),
+        (
+            r#"axes: [area_fraction([0.2]), seed([1, 2]), dt([0.01, 0.02])], figure: Some(eos)"#,
+            "axes[2] varies `dt` too",
         ),
     ];
     // A billion tasks: three axes of a thousand values.

@@ -118,9 +118,14 @@ fn eos_figure(rows: &[serde_json::Value], dir: &Path) -> anyhow::Result<()> {
             wall_seconds: sum("wall_seconds"),
         });
     }
+    let solver = rows
+        .first()
+        .and_then(|row| row["report"]["solver"].as_str())
+        .unwrap_or("the scene's solver");
+    let bars = format!("{solver}, standard error over seeds");
     let figure = EosFigure {
         points: &points,
-        bars: "standard error over seeds",
+        bars: &bars,
     };
     let [vector, picture] = ["eos.svg", "eos.png"].map(|name| dir.join(name));
     let drawing = svg(&figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", vector.display()))?;

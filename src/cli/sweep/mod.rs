@@ -11,14 +11,14 @@
 //! from it to the same bits.
 
 mod fields;
+mod local;
 mod merge;
 pub mod spec;
 
+pub use local::run;
 pub use merge::merge;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitStatus, Stdio};
-use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 
@@ -239,9 +239,8 @@ pub fn task(dir: &Path, index: Option<usize>) -> anyhow::Result<Finished> {
         ));
         return Ok(Finished::Completed);
     }
-    let outcome = run_task(&plan, task);
-    match &outcome {
-        Ok(Finished::Completed) => {
+    let outcome = run_task(&plan, task).and_then(|finished| {
+        if finished == Finished::Completed {
             // The dump first: a task with its report in `results/` has everything there.
             if plan.spec.dump {
                 let kept = folder.kept_dump(index);
@@ -253,10 +252,10 @@ pub fn task(dir: &Path, index: Option<usize>) -> anyhow::Result<Finished> {
             let _ = std::fs::remove_file(folder.checkpoint(index));
             let _ = std::fs::remove_file(folder.failure(index));
         }
-        Ok(Finished::Interrupted { .. }) => {}
-        Err(e) => {
-            let _ = write_atomically(&folder.failure(index), format!("{e:#}\n").as_bytes());
-        }
+        Ok(finished)
+    });
+    if let Err(e) = &outcome {
+        let _ = write_atomically(&folder.failure(index), format!("{e:#}\n").as_bytes());
     }
     outcome
 }
@@ -322,94 +321,6 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
         }
     }
     crate::cli::run::run(options)
-}
-
-/// `sweep run`: every task without a result, `jobs` at a time, each a `sweep task` process
-/// writing into `logs/`; then, every task done, [`merge`].
-pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
-    if jobs == 0 {
-        bail!("--jobs must be at least 1");
-    }
-    let plan = Plan::open(dir)?;
-    let folder = &plan.folder;
-    let pending: Vec<usize> = (0..plan.tasks.len())
-        .filter(|&i| !folder.result(i).exists())
-        .collect();
-    let program = std::env::current_exe().context("finding this program")?;
-    let bar = indicatif::ProgressBar::new(pending.len() as u64).with_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} tasks  eta {eta}  {msg}")
-            .expect("valid template"),
-    );
-    let mut queue = pending.iter().copied();
-    // Each task is waited for on a thread of its own, which says when it ends: the next one
-    // starts at once, with no polling.
-    type Ended = (usize, std::io::Result<ExitStatus>, Duration);
-    let (ended, ends) = std::sync::mpsc::channel::<Ended>();
-    let started = Instant::now();
-    let mut own_time = Duration::ZERO;
-    let mut running = 0;
-    let mut failed = Vec::new();
-    loop {
-        while running < jobs
-            && let Some(index) = queue.next()
-        {
-            let log = std::fs::OpenOptions::new()
-                .create(true)
-                .append(true)
-                .open(folder.log(index))
-                .with_context(|| format!("opening {}", folder.log(index).display()))?;
-            let start = Instant::now();
-            let mut child = Command::new(&program)
-                .args(["sweep", "task"])
-                .arg(dir)
-                .args(["--index", &index.to_string()])
-                .stdin(Stdio::null())
-                .stdout(log.try_clone()?)
-                .stderr(log)
-                .spawn()
-                .context("starting a task")?;
-            let ended = ended.clone();
-            std::thread::spawn(move || {
-                let status = child.wait();
-                ended.send((index, status, start.elapsed()))
-            });
-            running += 1;
-        }
-        if running == 0 {
-            break;
-        }
-        let (index, status, took) = ends.recv().expect("a waiting thread per running task");
-        running -= 1;
-        own_time += took;
-        if !status
-            .with_context(|| format!("waiting for task {index}"))?
-            .success()
-        {
-            failed.push(index);
-            bar.set_message(format!("{} failed", failed.len()));
-        }
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    let done = pending.len() - failed.len();
-    let wall = started.elapsed().as_secs_f64();
-    let per_job = own_time.as_secs_f64() / jobs as f64;
-    say(format_args!(
-        "{done} of {} tasks done here ({} done before) in {wall:.1} s; the tasks took \
-         {per_job:.1} s a job, from start to end: {:+.1} % in between",
-        pending.len(),
-        plan.tasks.len() - pending.len(),
-        100.0 * (wall / per_job.max(f64::MIN_POSITIVE) - 1.0)
-    ));
-    if !failed.is_empty() {
-        failed.sort_unstable();
-        bail!(
-            "tasks {failed:?} failed: `moving_circles sweep status {}` says why",
-            dir.display()
-        );
-    }
-    // Every task has its result: the merge (and its figure) is the sweep's outcome.
-    merge(dir)
 }
 
 /// `sweep status`: how many tasks are done, started (a checkpoint, or running), failed (with

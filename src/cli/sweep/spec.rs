@@ -81,7 +81,7 @@ pub enum Axis {
     /// Any field of the scene by its path (`effects.restitution`, `arena.size`,
     /// `soft.hertz`, `spawn.radius`), with values as the scene file would give them, an
     /// enum's variant as a string (`"lattice"`). Each task gets a scene file of its own.
-    Field(String, Vec<serde_json::Value>),
+    Field(String, Vec<ron::Value>),
 }
 
 impl Axis {
@@ -129,7 +129,8 @@ impl Axis {
             Self::AreaFraction(v) => task.area_fraction = Some(v[k]),
             Self::Steps(v) => task.length = SpecLength::Steps(v[k]),
             Self::Field(path, v) => {
-                task.fields.insert(path.clone(), v[k].clone());
+                task.fields
+                    .insert(path.clone(), super::fields::json_of(&v[k]));
             }
         }
     }
@@ -169,24 +170,29 @@ impl Axis {
                 }
             }
             Self::Steps(v) => check_steps(v, &field)?,
-            Self::Field(path, _) => {
-                let word = |w: &str| {
-                    !w.is_empty() && w.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
-                };
-                if !path.split('.').all(word) {
-                    return Err(FieldError::new(
-                        field,
-                        format!(
-                            "{path:?} is not a field's path: names (or list positions) joined by \
-                             dots, such as \"effects.restitution\""
-                        ),
-                    ));
-                }
-            }
+            Self::Field(path, values) => super::fields::check_axis(path, values, &field)?,
             Self::Seed(_) => {}
         }
-        Ok(())
+        // A value given twice is a typo, and would weigh twice in a mean over the axis.
+        let repeat = match self {
+            Self::Solver(v) => first_repeat(v.iter()),
+            Self::Dt(v) | Self::AreaFraction(v) => first_repeat(v.iter().map(|x| x.to_bits())),
+            Self::Seed(v) | Self::Steps(v) => first_repeat(v.iter()),
+            Self::Field(_, v) => first_repeat(v.iter()),
+        };
+        match repeat {
+            Some((j, k)) => bad(k, format!("repeats {field}[{j}]")),
+            None => Ok(()),
+        }
     }
+}
+
+/// The first value equal to an earlier one: `(earlier, later)` positions.
+fn first_repeat<T: std::hash::Hash + Eq>(items: impl Iterator<Item = T>) -> Option<(usize, usize)> {
+    let mut seen = std::collections::HashMap::new();
+    items
+        .enumerate()
+        .find_map(|(k, item)| seen.insert(item, k).map(|j| (j, k)))
 }
 
 /// Checks run lengths in steps.
@@ -319,13 +325,8 @@ impl SweepSpec {
                 format!("make {count} tasks, more than the {MAX_TASKS} a sweep may have"),
             ));
         }
-        if self.figure == Some(SweepFigure::Eos)
-            && !self.axes.iter().any(|a| matches!(a, Axis::AreaFraction(_)))
-        {
-            return Err(FieldError::new(
-                "figure",
-                "`eos` draws z against area fraction: the spec needs an `area_fraction` axis",
-            ));
+        if self.figure == Some(SweepFigure::Eos) {
+            self.check_eos_figure()?;
         }
         let slurm = &self.slurm;
         if slurm.concurrency == 0 {
@@ -337,6 +338,40 @@ impl SweepSpec {
                 format!(
                     "{:?} is not a Slurm time such as \"30:00\", \"01:00:00\" or \"2-00:00:00\"",
                     slurm.time_limit
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The `eos` figure draws z against the area fraction, the mean over seeds with its
+    /// standard error: the spec varies those two and nothing else.
+    fn check_eos_figure(&self) -> Result<(), FieldError> {
+        let axis = |f: fn(&Axis) -> bool| self.axes.iter().find(|a| f(a)).map_or(0, Axis::len);
+        if axis(|a| matches!(a, Axis::AreaFraction(_))) == 0 {
+            return Err(FieldError::new(
+                "figure",
+                "`eos` draws z against area fraction: the spec needs an `area_fraction` axis",
+            ));
+        }
+        if axis(|a| matches!(a, Axis::Seed(_))) < 2 || self.combine == Combine::Zip {
+            return Err(FieldError::new(
+                "figure",
+                "`eos` draws the standard error over seeds: the spec needs a `seed` axis of two \
+                 or more, combined by `product`",
+            ));
+        }
+        let other = self
+            .axes
+            .iter()
+            .position(|a| !matches!(a, Axis::AreaFraction(_) | Axis::Seed(_)) && a.len() > 1);
+        if let Some(k) = other {
+            return Err(FieldError::new(
+                "figure",
+                format!(
+                    "`eos` averages over seeds alone, but axes[{k}] varies {} too: sweep each \
+                     of its values in a spec of its own",
+                    self.axes[k].sets()
                 ),
             ));
         }

@@ -26,7 +26,7 @@ const LITERATURE: RGBColor = RGBColor(35, 139, 69);
 pub struct EosFigure<'a> {
     /// The measured points.
     pub points: &'a [EosPoint],
-    /// What the error bars are, for the legend.
+    /// The solver and what the error bars are, for the legend ("exact, block error bars").
     pub bars: &'a str,
 }
 
@@ -115,7 +115,7 @@ fn z_panel<DB: DrawingBackend>(
                 .map(|p| Circle::new((p.area_fraction, p.z), 4, MEASURED.filled())),
         )
         .map_err(err)?
-        .label(format!("measured (exact), {bars}"))
+        .label(format!("measured, {bars}"))
         .legend(|(x, y)| Circle::new((x + 12, y), 4, MEASURED.filled()));
     chart
         .configure_series_labels()
