@@ -10,6 +10,7 @@
 //! task's settings, so a task stopped by a signal writes a checkpoint and the next try goes on
 //! from it to the same bits.
 
+mod field_axis;
 mod fields;
 mod local;
 mod merge;

@@ -130,7 +130,7 @@ impl Axis {
             Self::Steps(v) => task.length = SpecLength::Steps(v[k]),
             Self::Field(path, v) => {
                 task.fields
-                    .insert(path.clone(), super::fields::json_of(&v[k]));
+                    .insert(path.clone(), super::field_axis::json_of(&v[k]));
             }
         }
     }
@@ -170,7 +170,7 @@ impl Axis {
                 }
             }
             Self::Steps(v) => check_steps(v, &field)?,
-            Self::Field(path, values) => super::fields::check_axis(path, values, &field)?,
+            Self::Field(path, values) => super::field_axis::check_axis(path, values, &field)?,
             Self::Seed(_) => {}
         }
         // A value given twice is a typo, and would weigh twice in a mean over the axis.
