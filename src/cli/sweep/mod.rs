@@ -110,8 +110,10 @@ pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
     let scene = scene
         .canonicalize()
         .with_context(|| format!("{}: scene: {}", spec_path.display(), scene.display()))?;
-    // The scene is checked now, not in each of a thousand tasks.
-    Scene::load(&scene)?;
+    // The scene is checked now, not in each of a thousand tasks; read once, it is also the
+    // base of the scenes `field` axes set.
+    let base = Scene::read(&scene)?;
+    base.to_config(&scene.display().to_string())?;
     spec.scene = scene;
     let text = ron::ser::to_string_pretty(&spec, ron::ser::PrettyConfig::default())
         .context("writing the spec")?;
@@ -140,11 +142,6 @@ pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
     }
     let mut tasks = spec.tasks();
     if tasks.iter().any(|t| !t.fields.is_empty()) {
-        let file = std::fs::File::open(&spec.scene)
-            .with_context(|| format!("{}", spec.scene.display()))?;
-        let text = read_limited(file, crate::tools::io::MAX_SCENE_BYTES)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", spec.scene.display()))?;
-        let base = Scene::parse(&text, &spec.scene.display().to_string())?;
         fields::write_scenes(&base, &mut tasks, out)
             .with_context(|| format!("{}", spec_path.display()))?;
     }

@@ -25,12 +25,17 @@ use crate::tools::io::{MAX_SCENE_BYTES, read_limited};
 impl Scene {
     /// Reads and checks a scene file into a configuration.
     pub fn load(path: &Path) -> Result<CirclesConfig, InputError> {
+        Self::read(path)?.to_config(&path.display().to_string())
+    }
+
+    /// Reads a scene file as it is written, unchecked ([`Scene::to_config`] checks it).
+    pub fn read(path: &Path) -> Result<Self, InputError> {
         let origin = path.display().to_string();
         let text = std::fs::File::open(path)
             .map_err(|e| format!("cannot read: {e}"))
             .and_then(|file| read_limited(file, MAX_SCENE_BYTES))
             .map_err(|message| InputError::whole(&origin, message))?;
-        Self::parse(&text, &origin)?.to_config(&origin)
+        Self::parse(&text, &origin)
     }
 
     /// Checks every field and builds the configuration. `origin` names the file in errors.
