@@ -75,6 +75,9 @@ enum Command {
         /// Seed of the velocities.
         #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = parse_seed)]
         seed: u64,
+        /// Area fractions measured at once, each a process (default: the cores).
+        #[arg(long, value_name = "K")]
+        jobs: Option<usize>,
     },
     /// Print the systems a scene schedules, one per line.
     Systems {
@@ -345,6 +348,7 @@ fn main() -> ExitCode {
             blocks,
             block,
             seed,
+            jobs,
         }) => {
             let options = moving_circles::tools::eos::EosOptions {
                 n,
@@ -355,7 +359,10 @@ fn main() -> ExitCode {
                 block,
                 seed,
             };
-            cli::eos::eos(&options, &out).map(|()| 0)
+            let jobs = jobs.unwrap_or_else(|| {
+                std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+            });
+            cli::eos::eos(&options, &out, jobs).map(|()| 0)
         }
         None => open_app(cli.app).map(|()| 0),
     };

@@ -7,6 +7,7 @@ use std::path::Path;
 use anyhow::Context;
 
 use super::{prepare_out, write_results};
+use crate::tools::accuracy::front::MEASURES;
 use crate::tools::accuracy::piles::{pile_study, pile_table};
 use crate::tools::accuracy::plot::AccuracyFigure;
 use crate::tools::accuracy::report::{to_fronts, to_table};
@@ -40,8 +41,8 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool) -> anyhow::Result<()> {
     });
     bar.finish_and_clear();
     to_table(&rows).lines().for_each(say);
-    to_fronts(&rows).lines().for_each(say);
-    write_results(&rows, &AccuracyFigure(&rows), out, "accuracy")?;
+    to_fronts(&rows, &MEASURES).lines().for_each(say);
+    write_results(&rows, &AccuracyFigure::study(&rows), out, "accuracy")?;
     piles(out, &pile_cases, quick)
 }
 

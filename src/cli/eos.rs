@@ -1,34 +1,36 @@
-//! `moving_circles eos`: the hard-disk equation of state, one area fraction after another with
-//! a progress bar; prints a table and writes `eos.csv`, `eos.svg` and `eos.png`.
+//! `moving_circles eos`: the hard-disk equation of state, each area fraction a task of a
+//! sweep (planned into `OUT/eos-tasks/` with the `eos` measure, run `--jobs` at a time by the
+//! runner of `sweep run`); prints a table and writes `eos.csv`, `eos.svg` and `eos.png`.
+//! Run again with the same options, it measures only the points not done; the same options
+//! as a spec run on Slurm unchanged (`assets/sweeps/eos.ron`).
 
 use std::path::Path;
 
-use super::{prepare_out, write_results};
+use super::sweep::spec::{
+    Axis, Combine, EosMeasure, SlurmSettings, SweepFigure, SweepSpec, TaskMeasure,
+};
+use super::{prepare_out, sweep, write_results};
 use crate::tools::eos::plot::EosFigure;
-use crate::tools::eos::{EosOptions, EosPoint, measure};
+use crate::tools::eos::{EosOptions, EosPoint};
 use crate::tools::io::say;
 
-/// Measures every area fraction of `options` and writes the results into `out`.
-pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
+/// Measures every area fraction of `options`, `jobs` at a time, and writes the results into
+/// `out`; the tasks' folder is `out/eos-tasks`.
+pub fn eos(options: &EosOptions, out: &Path, jobs: usize) -> anyhow::Result<()> {
     options.check()?;
     prepare_out(out, &["eos.csv", "eos.svg", "eos.png"])?;
-    let bar = indicatif::ProgressBar::new(options.area_fractions.len() as u64).with_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} area fractions  {msg}")
-            .expect("valid template"),
-    );
+    let spec = sweep_spec(options);
+    spec.check()
+        .map_err(|e| anyhow::anyhow!("the options as a sweep: {e}"))?;
+    let tasks = out.join("eos-tasks");
+    sweep::plan_spec(&spec, "these `eos` options", &tasks)?;
+    sweep::run(&tasks, jobs)?;
+    let points = sweep::eos_points(&tasks)?;
     say(format_args!(
         "{:>6} {:>6} {:>9} {:>8} {:>9} {:>9} {:>8} {:>10} {:>7} {:>7}",
         "eta", "n", "Z", "± err", "Henderson", "Liu", "vs Liu", "collisions", "KS", "s"
     ));
-    let mut points = Vec::new();
-    for &phi in &options.area_fractions {
-        bar.set_message(format!("η = {phi}"));
-        let point = measure(options, phi).map_err(anyhow::Error::msg)?;
-        bar.suspend(|| say(row(&point)));
-        bar.inc(1);
-        points.push(point);
-    }
-    bar.finish_and_clear();
+    points.iter().map(row).for_each(say);
     write_results(
         &points,
         &EosFigure {
@@ -38,6 +40,25 @@ pub fn eos(options: &EosOptions, out: &Path) -> anyhow::Result<()> {
         out,
         "eos",
     )
+}
+
+/// The sweep `eos` runs for `options`: the `eos` measure at each area fraction, one seed,
+/// the figure drawn at the merge, Slurm's settings the defaults. With the default options it
+/// is `assets/sweeps/eos.ron`.
+pub fn sweep_spec(options: &EosOptions) -> SweepSpec {
+    SweepSpec {
+        scene: None,
+        length: None,
+        measure: TaskMeasure::Eos(EosMeasure::of_options(options)),
+        axes: vec![
+            Axis::AreaFraction(options.area_fractions.clone()),
+            Axis::Seed(vec![options.seed]),
+        ],
+        combine: Combine::Product,
+        slurm: SlurmSettings::default(),
+        figure: Some(SweepFigure::Eos),
+        dump: false,
+    }
 }
 
 fn row(p: &EosPoint) -> String {

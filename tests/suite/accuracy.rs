@@ -10,7 +10,7 @@ use moving_circles::prelude::*;
 use moving_circles::tools::accuracy::auto::choose_solver;
 use moving_circles::tools::accuracy::front::MEASURES;
 use moving_circles::tools::accuracy::passed_through;
-use moving_circles::tools::accuracy::plot::FIGURE_SIZE;
+use moving_circles::tools::accuracy::plot::AccuracyFigure;
 
 fn circle(x: f64, vx: f64) -> CircleState {
     CircleState::new(DVec2::new(x, 0.0), DVec2::new(vx, 0.0), 0.1)
@@ -125,7 +125,7 @@ fn the_study_writes_a_csv_with_every_solver_and_its_figure_as_svg_and_png() {
     let mut reader = decoder.read_info().unwrap();
     let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut pixels).unwrap();
-    assert_eq!((info.width, info.height), FIGURE_SIZE);
+    assert_eq!((info.width, info.height), AccuracyFigure::size_for(5));
     let count = |rgb: [u8; 3]| pixels.chunks(3).filter(|p| *p == rgb).count();
     assert!(count([255, 200, 60]) > 1000, "no Pareto front drawn");
     assert!(count([117, 80, 170]) > 1000, "no reference drawn");

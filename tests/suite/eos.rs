@@ -41,6 +41,61 @@ fn a_small_box_gives_liu_s_pressure_and_rayleigh_speeds() {
 }
 
 #[test]
+fn the_command_measures_each_point_as_a_task_and_does_not_measure_it_again() {
+    let out = std::env::temp_dir().join(format!("mc-eos-tasks-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let run = |fractions: &str| {
+        Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+            .args(["eos", "--out", out.to_str().unwrap(), "--n", "100"])
+            .args(["--area-fractions", fractions, "--equilibrate", "10"])
+            .args([
+                "--blocks", "3", "--block", "10", "--seed", "7", "--jobs", "2",
+            ])
+            .output()
+            .unwrap()
+    };
+    let first = run("0.2,0.5");
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    // Each task measured what `measure` measures in this process, to the bit.
+    let options = EosOptions {
+        n: 100,
+        area_fractions: vec![0.2, 0.5],
+        equilibrate: 10.0,
+        blocks: 3,
+        block: 10.0,
+        seed: 7,
+    };
+    let csv = std::fs::read_to_string(out.join("eos.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let z_column = header.iter().position(|&h| h == "z").unwrap();
+    for (line, phi) in csv.lines().skip(1).zip([0.2, 0.5]) {
+        let z: f64 = line.split(',').nth(z_column).unwrap().parse().unwrap();
+        assert_eq!(z, measure(&options, phi).unwrap().z, "at {phi}");
+    }
+    // Again with the same options: both points are done, none is measured again.
+    let again = run("0.2,0.5");
+    let said = String::from_utf8_lossy(&again.stdout);
+    assert!(
+        again.status.success() && said.contains("0 of 0 tasks done here (2 done before)"),
+        "{said}"
+    );
+    assert_eq!(std::fs::read_to_string(out.join("eos.csv")).unwrap(), csv);
+    // Other options would mix two measurements in one folder: refused, nothing overwritten.
+    let other = run("0.2,0.6");
+    let stderr = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        !other.status.success() && stderr.contains("holds another sweep's plan"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(out.join("eos.csv")).unwrap(), csv);
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
 fn the_command_writes_a_csv_and_the_figure_and_refuses_bad_options() {
     let out = std::env::temp_dir().join(format!("mc-eos-{}", std::process::id()));
     let run = |args: &[&str]| {

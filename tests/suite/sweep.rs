@@ -361,6 +361,53 @@ fn an_eos_sweep_draws_the_mean_z_of_each_area_fraction_over_its_seeds() {
 }
 
 #[test]
+fn an_accuracy_sweep_draws_each_settings_cost_against_its_errors() {
+    let dir = scratch_dir("sweep", "accuracy");
+    let spec = spec_file(
+        &dir,
+        &format!(
+            r#"(scene: "{}", length: seconds(0.5),
+                axes: [solver(["discrete", "exact"]), dt([0.03333333333333333, 0.016666666666666666]),
+                       seed([1, 2])],
+                figure: Some(accuracy))"#,
+            gas1k()
+        ),
+    );
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    successful(&["sweep", "plan", &spec, "--out", out]);
+    let ran = successful(&["sweep", "run", out, "--jobs", "2"]);
+    let said = stdout(&ran);
+    // The front of the deepest overlap ends at `exact` (at whichever rate is cheaper), which
+    // leaves none.
+    let overlap = said
+        .lines()
+        .find(|l| l.starts_with("gas1k") && l.contains("deepest overlap"))
+        .unwrap_or_else(|| panic!("no front of the deepest overlap: {said}"));
+    let last = overlap.rsplit(" > ").next().unwrap();
+    assert!(last.contains("exact at"), "{overlap}");
+    assert!(overlap.ends_with("(0.00e0)"), "{overlap}");
+    assert!(said.contains("drew what accuracy costs into"), "{said}");
+    let drawing = std::fs::read_to_string(dir.join("out/accuracy.svg")).unwrap();
+    for measure in moving_circles::tools::accuracy::front::REPORT_MEASURES {
+        assert!(
+            drawing.contains(measure.title),
+            "no panel of {}",
+            measure.title
+        );
+    }
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(dir.join("out/accuracy.png")).unwrap(),
+    ));
+    let info = decoder.read_info().unwrap().info().clone();
+    assert_eq!(
+        (info.width, info.height),
+        moving_circles::tools::accuracy::plot::AccuracyFigure::size_for(1)
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn hostile_specs_are_refused_naming_the_field() {
     let scene = gas1k();
     let cases = [
@@ -408,6 +455,14 @@ fn hostile_specs_are_refused_naming_the_field() {
             r#"axes: [area_fraction([0.2]), seed([1, 2]), dt([0.01, 0.02])], figure: Some(eos)"#,
             "axes[2] varies `dt` too",
         ),
+        (
+            r#"axes: [solver(["discrete", "swept"])], figure: Some(accuracy)"#,
+            "a `solver` axis that includes \"exact\"",
+        ),
+        (
+            r#"axes: [solver(["discrete", "exact"]), dt([0.01, 0.02])], figure: Some(accuracy)"#,
+            "needs 0.016666666666666666 (1/60)",
+        ),
     ];
     // A billion tasks: three axes of a thousand values.
     let thousand = |f: &dyn Fn(usize) -> String| (0..1000).map(f).collect::<Vec<_>>().join(",");
@@ -425,6 +480,40 @@ fn hostile_specs_are_refused_naming_the_field() {
         let text = format!(r#"(scene: "{scene}", length: steps(10), {extra})"#);
         let error = SweepSpec::parse(&text, "s.ron").unwrap_err();
         assert!(error.contains(expected), "{extra}: {error}");
+    }
+    // The `eos` measure places its own disks and counts collisions: no scene, no length, and
+    // only area fraction and seed vary; its options are checked as the `eos` command's.
+    let eos = r#"measure: eos(n: 100), axes: [area_fraction([0.3])]"#;
+    for (text, expected) in [
+        ("(length: steps(10))".to_owned(), "scene: missing"),
+        (format!(r#"(scene: "{scene}")"#), "length: missing"),
+        (
+            format!(r#"(scene: "{scene}", {eos})"#),
+            "scene: the `eos` measure",
+        ),
+        (
+            format!("(length: steps(10), {eos})"),
+            "length: the `eos` measure",
+        ),
+        (
+            r#"(measure: eos(n: 100), axes: [area_fraction([0.3]), dt([0.01])])"#.to_owned(),
+            "axes[1]: the `eos` measure varies `area_fraction` and `seed` alone, not `dt`",
+        ),
+        (
+            r#"(measure: eos(n: 1), axes: [area_fraction([0.3])])"#.to_owned(),
+            "measure.eos.n: needs 2 to",
+        ),
+        (
+            r#"(measure: eos(n: 100), axes: [area_fraction([0.3, 0.9])])"#.to_owned(),
+            "axes[0].area_fraction[1]: each must be in (0, 0.85]",
+        ),
+        (
+            r#"(measure: eos(n: 100))"#.to_owned(),
+            "axes: the `eos` measure needs",
+        ),
+    ] {
+        let error = SweepSpec::parse(&text, "s.ron").unwrap_err();
+        assert!(error.contains(expected), "{text}: {error}");
     }
 }
 
@@ -467,17 +556,24 @@ fn a_folder_holding_another_sweeps_plan_is_refused() {
 }
 
 #[test]
+fn the_eos_spec_that_ships_is_the_sweep_the_eos_command_runs() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/sweeps/eos.ron");
+    assert_eq!(
+        SweepSpec::read(&path).unwrap(),
+        moving_circles::cli::eos::sweep_spec(&moving_circles::tools::eos::EosOptions::default())
+    );
+}
+
+#[test]
 fn the_specs_that_ship_are_valid_and_name_scenes_that_exist() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/sweeps");
     let mut seen = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         let spec = SweepSpec::read(&path).unwrap();
-        assert!(
-            dir.join(&spec.scene).is_file(),
-            "{path:?}: {:?}",
-            spec.scene
-        );
+        if let Some(scene) = &spec.scene {
+            assert!(dir.join(scene).is_file(), "{path:?}: {scene:?}");
+        }
         seen += 1;
     }
     assert!(seen >= 2);

@@ -21,7 +21,8 @@ use crate::tools::io::{self, say};
 use crate::tools::run::{Progress, Report, advance, default_sampling, out_of_range, sample_end};
 use crate::tools::scene::particles;
 pub use options::{Finished, Input, Length, MAX_STEPS, MAX_THREADS, RunOptions, SolverChoice};
-use setup::{check_outputs, configure, set_threads, start, steps_of};
+pub(crate) use setup::set_threads;
+use setup::{check_outputs, configure, start, steps_of};
 
 /// Runs `options` to the end (or to a signal): loads, steps, prints the summary, writes the
 /// outputs.

@@ -70,7 +70,7 @@ pub(super) fn steps_of(length: Length, dt: f64) -> anyhow::Result<u64> {
     })
 }
 
-pub(super) fn set_threads(threads: Option<u16>) {
+pub(crate) fn set_threads(threads: Option<u16>) {
     if let Some(threads) = threads {
         // Set up before the App, whose task pool plugin keeps a pool that already exists.
         bevy::tasks::ComputeTaskPool::get_or_init(|| {

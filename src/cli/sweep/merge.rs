@@ -5,12 +5,8 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 
-use super::Plan;
 use super::spec::SweepFigure;
-use crate::tools::eos::EosPoint;
-use crate::tools::eos::plot::EosFigure;
-use crate::tools::eos::theory::{henderson_z, liu_z};
-use crate::tools::figure::{png, svg};
+use super::{Plan, figures};
 use crate::tools::io::{read_limited, say, write_atomically};
 
 /// `sweep merge`: every task's settings and report as one row, into `merged.csv` and
@@ -60,85 +56,11 @@ pub fn merge(dir: &Path) -> anyhow::Result<()> {
         csv_path.display(),
         json_path.display()
     ));
-    if plan.spec.figure == Some(SweepFigure::Eos) {
-        eos_figure(&rows, dir)?;
+    match plan.spec.figure {
+        Some(SweepFigure::Eos) => figures::eos(&rows, dir)?,
+        Some(SweepFigure::Accuracy) => figures::accuracy(&rows, &plan.spec, dir)?,
+        None => {}
     }
-    Ok(())
-}
-
-/// The equation of state of the merged rows: for each area fraction, the mean of the tasks'
-/// `z` and its standard error, drawn as the `eos` command draws its points, into `eos.svg`
-/// and `eos.png` in `dir`.
-fn eos_figure(rows: &[serde_json::Value], dir: &Path) -> anyhow::Result<()> {
-    let mut by_fraction: Vec<(f64, Vec<&serde_json::Value>)> = Vec::new();
-    for row in rows {
-        let Some(phi) = row["task"]["area_fraction"].as_f64() else {
-            continue;
-        };
-        match by_fraction.iter_mut().find(|(f, _)| *f == phi) {
-            Some((_, group)) => group.push(&row["report"]),
-            None => by_fraction.push((phi, vec![&row["report"]])),
-        }
-    }
-    by_fraction.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut points = Vec::new();
-    for (phi, reports) in by_fraction {
-        let zs: Vec<f64> = reports.iter().filter_map(|r| r["z"].as_f64()).collect();
-        if zs.is_empty() {
-            bail!("no task at area fraction {phi} measured z (the report's `z`)");
-        }
-        let k = zs.len() as f64;
-        let z = zs.iter().sum::<f64>() / k;
-        let spread = zs.iter().map(|x| (x - z).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
-        let sum = |field: &str| {
-            reports
-                .iter()
-                .filter_map(|r| r[field].as_f64())
-                .sum::<f64>()
-        };
-        let liu = liu_z(phi);
-        let z_error = (spread / k).sqrt();
-        say(format_args!(
-            "area fraction {phi}: z {z:.5} ± {z_error:.5} over {} tasks (Liu {liu:.5})",
-            zs.len()
-        ));
-        points.push(EosPoint {
-            area_fraction: phi,
-            n: (sum("n") / reports.len() as f64).round() as usize,
-            z,
-            z_error,
-            henderson: henderson_z(phi),
-            liu,
-            vs_liu: z / liu - 1.0,
-            blocks: zs.len(),
-            collisions: sum("pair_collisions") as u64,
-            sim_seconds: sum("sim_seconds"),
-            speed_ks: f64::NAN,
-            speed_ks_critical: f64::NAN,
-            wall_seconds: sum("wall_seconds"),
-        });
-    }
-    let solver = rows
-        .first()
-        .and_then(|row| row["report"]["solver"].as_str())
-        .unwrap_or("the scene's solver");
-    let bars = format!("{solver}, standard error over seeds");
-    let figure = EosFigure {
-        points: &points,
-        bars: &bars,
-    };
-    let [vector, picture] = ["eos.svg", "eos.png"].map(|name| dir.join(name));
-    let drawing = svg(&figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", vector.display()))?;
-    write_atomically(&vector, drawing.as_bytes())
-        .with_context(|| format!("writing {}", vector.display()))?;
-    let bytes = png(&figure).map_err(|e| anyhow::anyhow!("drawing {}: {e}", picture.display()))?;
-    write_atomically(&picture, &bytes).with_context(|| format!("writing {}", picture.display()))?;
-    say(format_args!(
-        "drew the equation of state of {} area fractions into {} and {}",
-        points.len(),
-        vector.display(),
-        picture.display()
-    ));
     Ok(())
 }
 

@@ -12,9 +12,14 @@
 
 mod field_axis;
 mod fields;
+mod figures;
 mod local;
+mod measure;
 mod merge;
+mod slurm;
 pub mod spec;
+mod spec_rules;
+mod task;
 
 pub use local::run;
 pub use merge::merge;
@@ -25,9 +30,10 @@ use anyhow::{Context, bail};
 
 use crate::cli::run::{Finished, Input, Length, RunOptions, SolverChoice};
 use crate::tools::checkpoint::Checkpoint;
+use crate::tools::eos::{EosOptions, measure};
 use crate::tools::io::{read_limited, say, write_atomically};
 use crate::tools::scene::Scene;
-use spec::{MAX_SPEC_BYTES, SpecLength, SweepSpec, Task};
+use spec::{EosMeasure, MAX_SPEC_BYTES, SpecLength, SweepSpec, Task, TaskMeasure};
 
 /// The files and folders of a planned sweep.
 struct Folder {
@@ -105,18 +111,55 @@ impl Plan {
 /// `sweep plan`: checks the spec and its scene, and writes the plan into `out`.
 pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
     let mut spec = SweepSpec::read(spec_path).map_err(anyhow::Error::msg)?;
-    let base = spec_path.parent().unwrap_or(Path::new("."));
-    let scene = base.join(&spec.scene);
-    let scene = scene
-        .canonicalize()
-        .with_context(|| format!("{}: scene: {}", spec_path.display(), scene.display()))?;
+    if let Some(relative) = &spec.scene {
+        let scene = spec_path.parent().unwrap_or(Path::new(".")).join(relative);
+        spec.scene = Some(
+            scene
+                .canonicalize()
+                .with_context(|| format!("{}: scene: {}", spec_path.display(), scene.display()))?,
+        );
+    }
+    let tasks = plan_spec(&spec, &spec_path.display().to_string(), out)?;
+    if let Some(tasks) = tasks {
+        say(format_args!("planned {tasks} tasks in {}", out.display()));
+        say(format_args!(
+            "  here:     moving_circles sweep run {} --jobs 2",
+            out.display()
+        ));
+        say(format_args!(
+            "  on Slurm: sbatch {}",
+            Folder {
+                dir: out.to_owned()
+            }
+            .script()
+            .display()
+        ));
+    }
+    Ok(())
+}
+
+/// Writes the plan of `spec` (checked, its scene's path absolute; `origin` names it in
+/// errors) into `out`: its number of tasks, or `None` when `out` holds this plan already.
+pub(crate) fn plan_spec(
+    spec: &SweepSpec,
+    origin: &str,
+    out: &Path,
+) -> anyhow::Result<Option<usize>> {
     // The scene is checked now, not in each of a thousand tasks; read once, it is also the
     // base of the scenes `field` axes set.
-    let base = Scene::read(&scene)?;
-    base.to_config(&scene.display().to_string())?;
-    spec.scene = scene;
-    let text = ron::ser::to_string_pretty(&spec, ron::ser::PrettyConfig::default())
-        .context("writing the spec")?;
+    let base = match &spec.scene {
+        Some(scene) => {
+            let base = Scene::read(scene)?;
+            base.to_config(&scene.display().to_string())?;
+            Some(base)
+        }
+        None => None,
+    };
+    // Written as a spec is read: `scene: "..."`, `eos(n: 4096)`.
+    let extensions = ron::extensions::Extensions::IMPLICIT_SOME
+        | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES;
+    let pretty = ron::ser::PrettyConfig::default().extensions(extensions);
+    let text = ron::ser::to_string_pretty(spec, pretty).context("writing the spec")?;
     let folder = Folder {
         dir: out.to_owned(),
     };
@@ -127,13 +170,12 @@ pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
                 "{} holds this sweep's plan already",
                 out.display()
             ));
-            return Ok(());
+            return Ok(None);
         }
         bail!(
-            "{} holds another sweep's plan (its spec.ron differs from {}): plan into an empty \
-             folder, or remove that one",
+            "{} holds another sweep's plan (its spec.ron differs from {origin}): plan into an \
+             empty folder, or remove that one",
             out.display(),
-            spec_path.display()
         );
     }
     for sub in ["results", "failed", "work", "logs", "scenes"] {
@@ -141,9 +183,10 @@ pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
         std::fs::create_dir_all(&path).with_context(|| format!("creating {}", path.display()))?;
     }
     let mut tasks = spec.tasks();
-    if tasks.iter().any(|t| !t.fields.is_empty()) {
-        fields::write_scenes(&base, &mut tasks, out)
-            .with_context(|| format!("{}", spec_path.display()))?;
+    if let Some(base) = &base
+        && tasks.iter().any(|t| !t.fields.is_empty())
+    {
+        fields::write_scenes(base, &mut tasks, out).with_context(|| origin.to_owned())?;
     }
     let mut lines = String::new();
     for task in &tasks {
@@ -155,59 +198,13 @@ pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
     let dir = out
         .canonicalize()
         .with_context(|| format!("{}", out.display()))?;
-    let script = batch_script(&spec, tasks.len(), &dir)?;
+    let script = slurm::batch_script(&spec.slurm, tasks.len(), &dir)?;
     write_atomically(&folder.script(), script.as_bytes())
         .with_context(|| format!("writing {}", folder.script().display()))?;
     // Last: a folder with a spec holds a whole plan.
     write_atomically(&folder.spec(), text.as_bytes())
         .with_context(|| format!("writing {}", folder.spec().display()))?;
-    say(format_args!(
-        "planned {} tasks in {}",
-        tasks.len(),
-        out.display()
-    ));
-    say(format_args!(
-        "  here:     moving_circles sweep run {} --jobs 2",
-        out.display()
-    ));
-    say(format_args!(
-        "  on Slurm: sbatch {}",
-        folder.script().display()
-    ));
-    Ok(())
-}
-
-/// The Slurm batch script of the whole array.
-fn batch_script(spec: &SweepSpec, tasks: usize, dir: &Path) -> anyhow::Result<String> {
-    let program = std::env::current_exe().context("finding this program")?;
-    let slurm = &spec.slurm;
-    let quote = |p: &Path| format!("'{}'", p.display().to_string().replace('\'', r"'\''"));
-    Ok(format!(
-        "#!/bin/bash\n\
-         # One Slurm array task per sweep task; each runs `moving_circles sweep task`, which\n\
-         # reads its index from SLURM_ARRAY_TASK_ID.\n\
-         #SBATCH --job-name=moving_circles-sweep\n\
-         # Tasks 0 to {last}, at most {concurrency} at once.\n\
-         #SBATCH --array=0-{last}%{concurrency}\n\
-         #SBATCH --ntasks=1\n\
-         #SBATCH --cpus-per-task=1\n\
-         #SBATCH --time={time}\n\
-         # SIGTERM {warn} s before the time limit: the task writes a checkpoint and stops;\n\
-         # requeued, it goes on from the checkpoint.\n\
-         #SBATCH --signal=B:TERM@{warn}\n\
-         #SBATCH --requeue\n\
-         #SBATCH --open-mode=append\n\
-         #SBATCH --output={dir}/logs/slurm-%A_%a.log\n\
-         # exec: the signal reaches the task itself, not a shell waiting for it.\n\
-         exec {program} sweep task {qdir}\n",
-        last = tasks - 1,
-        concurrency = slurm.concurrency,
-        time = slurm.time_limit,
-        warn = slurm.warn_seconds,
-        dir = dir.display(),
-        program = quote(&program),
-        qdir = quote(dir),
-    ))
+    Ok(Some(tasks.len()))
 }
 
 /// `sweep task`: runs task `index` (from `SLURM_ARRAY_TASK_ID` when `None`), or does nothing
@@ -237,7 +234,11 @@ pub fn task(dir: &Path, index: Option<usize>) -> anyhow::Result<Finished> {
         ));
         return Ok(Finished::Completed);
     }
-    let outcome = run_task(&plan, task).and_then(|finished| {
+    let outcome = match &plan.spec.measure {
+        TaskMeasure::Report => run_task(&plan, task),
+        TaskMeasure::Eos(eos) => eos_task(folder, eos, task),
+    };
+    let outcome = outcome.and_then(|finished| {
         if finished == Finished::Completed {
             // The dump first: a task with its report in `results/` has everything there.
             if plan.spec.dump {
@@ -258,18 +259,36 @@ pub fn task(dir: &Path, index: Option<usize>) -> anyhow::Result<Finished> {
     outcome
 }
 
+/// Measures the equation of state at `task`'s area fraction and seed into its report.
+fn eos_task(folder: &Folder, eos: &EosMeasure, task: &Task) -> anyhow::Result<Finished> {
+    let phi = task
+        .area_fraction
+        .context("an `eos` task has an area fraction")?;
+    let options = eos.options(phi, task.seed.unwrap_or(EosOptions::default().seed));
+    crate::cli::run::set_threads(Some(1));
+    let point = measure(&options, phi).map_err(anyhow::Error::msg)?;
+    let path = folder.report(task.index);
+    let text = serde_json::to_string_pretty(&point).context("the point as JSON")?;
+    write_atomically(&path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(Finished::Completed)
+}
+
 /// Runs `task` from its scene, or from the checkpoint an earlier try left.
 fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
     let folder = &plan.folder;
     let checkpoint = folder.checkpoint(task.index);
-    let length = match task.length {
+    let (Some(task_length), Some(scene)) = (task.length, &plan.spec.scene) else {
+        bail!("a `report` task has a scene and a length");
+    };
+    let length = match task_length {
         SpecLength::Steps(steps) => Length::Steps(steps),
         SpecLength::Seconds(seconds) => Length::Seconds(seconds),
     };
     let mut options = RunOptions {
         input: Input::Scene(match &task.scene {
             Some(own) => folder.dir.join(own),
-            None => plan.spec.scene.clone(),
+            None => scene.clone(),
         }),
         solver: task
             .solver
@@ -292,7 +311,7 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
     };
     if checkpoint.exists() {
         let saved = Checkpoint::read(&checkpoint)?;
-        let total = match task.length {
+        let total = match task_length {
             SpecLength::Steps(steps) => steps,
             SpecLength::Seconds(seconds) => (seconds / saved.dt()).ceil() as u64,
         };
@@ -319,6 +338,22 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
         }
     }
     crate::cli::run::run(options)
+}
+
+/// The points of the `eos` sweep in `dir`, in task order; every task must be done.
+pub(crate) fn eos_points(dir: &Path) -> anyhow::Result<Vec<crate::tools::eos::EosPoint>> {
+    let plan = Plan::open(dir)?;
+    plan.tasks
+        .iter()
+        .map(|task| {
+            let path = plan.folder.result(task.index);
+            let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
+            let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
+            let json =
+                serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
+            figures::eos_point(&json).with_context(|| format!("{}", path.display()))
+        })
+        .collect()
 }
 
 /// `sweep status`: how many tasks are done, started (a checkpoint, or running), failed (with

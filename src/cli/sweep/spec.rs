@@ -8,6 +8,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+pub use super::measure::{EosMeasure, TaskMeasure};
+pub use super::slurm::SlurmSettings;
+pub use super::task::{SpecLength, Task};
 use crate::base::config::{DT_RANGE, Solver};
 use crate::base::error::FieldError;
 
@@ -22,10 +25,18 @@ pub const MAX_SPEC_BYTES: u64 = 1 << 20;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
-    /// The scene every task starts from, relative to the spec's folder.
-    pub scene: PathBuf,
-    /// How long each task runs (an axis `steps` or `seconds` overrides it).
-    pub length: SpecLength,
+    /// The scene every task starts from, relative to the spec's folder (none with the `eos`
+    /// measure, which places its own disks).
+    #[serde(default)]
+    pub scene: Option<PathBuf>,
+    /// How long each task runs (an axis `steps` overrides it; none with the `eos` measure,
+    /// which runs until it has counted its collisions).
+    #[serde(default)]
+    pub length: Option<SpecLength>,
+    /// What each task measures: a `run`'s report (the default), or a point of the equation
+    /// of state.
+    #[serde(default)]
+    pub measure: TaskMeasure,
     /// What the tasks vary.
     #[serde(default)]
     pub axes: Vec<Axis>,
@@ -52,16 +63,12 @@ pub enum SweepFigure {
     /// the tasks of each area fraction (the seeds) with its standard error, over Henderson's
     /// and Liu's curves (`eos.svg`, `eos.png`).
     Eos,
-}
-
-/// How long a task runs.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SpecLength {
-    /// Fixed steps.
-    Steps(u64),
-    /// Simulated seconds.
-    Seconds(f64),
+    /// What accuracy costs: for each setting of solver and step, cost (ms of stepping per
+    /// simulated second) against the errors a report carries (pair collisions and `z`
+    /// against the `exact` task at 60 Hz with the same seed and other settings, deepest
+    /// overlap), each the mean over the seeds, one row of panels for each setting of the other
+    /// axes; the Pareto fronts printed (`accuracy.svg`, `accuracy.png`).
+    Accuracy,
 }
 
 /// One thing the tasks vary, with its values.
@@ -98,7 +105,7 @@ impl Axis {
     }
 
     /// What it sets: its name, or a field's path.
-    fn sets(&self) -> String {
+    pub(super) fn sets(&self) -> String {
         match self {
             Self::Field(path, _) => format!("field {path:?}"),
             other => format!("`{}`", other.name()),
@@ -127,7 +134,7 @@ impl Axis {
             Self::Dt(v) => task.dt = Some(v[k]),
             Self::Seed(v) => task.seed = Some(v[k]),
             Self::AreaFraction(v) => task.area_fraction = Some(v[k]),
-            Self::Steps(v) => task.length = SpecLength::Steps(v[k]),
+            Self::Steps(v) => task.length = Some(SpecLength::Steps(v[k])),
             Self::Field(path, v) => {
                 task.fields
                     .insert(path.clone(), super::field_axis::json_of(&v[k]));
@@ -218,57 +225,14 @@ pub enum Combine {
     Zip,
 }
 
-/// How the Slurm array runs.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SlurmSettings {
-    /// Tasks running at once (`--array=0-N%K`).
-    pub concurrency: u32,
-    /// Each task's time limit (`--time`, e.g. `"00:30:00"`).
-    pub time_limit: String,
-    /// Seconds before the limit at which a task is told to checkpoint and stop (SIGTERM); it
-    /// is requeued and goes on from its checkpoint.
-    pub warn_seconds: u32,
-}
-
-impl Default for SlurmSettings {
-    fn default() -> Self {
-        Self {
-            concurrency: 16,
-            time_limit: "01:00:00".into(),
-            warn_seconds: 60,
-        }
-    }
-}
-
-/// One task of a sweep: the scene's settings with what the axes set.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Task {
-    /// Its index in the sweep (Slurm's array index).
-    pub index: usize,
-    /// The solver, if an axis sets it (else the scene's).
-    pub solver: Option<String>,
-    /// The fixed step, if an axis sets it.
-    pub dt: Option<f64>,
-    /// The placement seed, if an axis sets it.
-    pub seed: Option<u64>,
-    /// The area fraction, if an axis sets it.
-    pub area_fraction: Option<f64>,
-    /// How long it runs.
-    pub length: SpecLength,
-    /// The scene fields its `field` axes set, by path.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    pub fields: BTreeMap<String, serde_json::Value>,
-    /// Its own scene file in the sweep's folder (`scenes/K.ron`), when it sets fields.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub scene: Option<String>,
-}
-
 impl SweepSpec {
     /// Parses and checks a spec's text; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self, String> {
+        // `scene: "..."` for an optional field, and `eos(n: 4096)` for a variant holding a
+        // struct.
         let spec: Self = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+            .with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES)
             .from_str(text)
             .map_err(|e| format!("{origin}: {e}"))?;
         spec.check().map_err(|e| format!("{origin}: {e}"))?;
@@ -286,14 +250,15 @@ impl SweepSpec {
     /// Checks every field.
     pub fn check(&self) -> Result<(), FieldError> {
         match self.length {
-            SpecLength::Steps(steps) => check_steps(&[steps], "length.steps")?,
-            SpecLength::Seconds(s) if !(s.is_finite() && s > 0.0 && s <= 1e9) => {
+            Some(SpecLength::Steps(steps)) => check_steps(&[steps], "length.steps")?,
+            Some(SpecLength::Seconds(s)) if !(s.is_finite() && s > 0.0 && s <= 1e9) => {
                 return Err(FieldError::new(
                     "length.seconds",
                     format!("must be above 0 and at most 1e9, got {s}"),
                 ));
             }
-            SpecLength::Seconds(_) => {}
+            Some(SpecLength::Seconds(_)) => {}
+            None => {}
         }
         for (k, axis) in self.axes.iter().enumerate() {
             axis.check(&format!("axes[{k}]"))?;
@@ -317,6 +282,7 @@ impl SweepSpec {
                 ),
             ));
         }
+        self.check_measure()?;
         let tasks = self.task_count();
         if tasks.is_none_or(|n| n > MAX_TASKS) {
             let count = tasks.map_or("more than 2^64".into(), |n| n.to_string());
@@ -325,53 +291,21 @@ impl SweepSpec {
                 format!("make {count} tasks, more than the {MAX_TASKS} a sweep may have"),
             ));
         }
-        if self.figure == Some(SweepFigure::Eos) {
-            self.check_eos_figure()?;
+        match self.figure {
+            Some(SweepFigure::Eos) => self.check_eos_figure()?,
+            Some(SweepFigure::Accuracy) => self.check_accuracy_figure()?,
+            None => {}
         }
         let slurm = &self.slurm;
         if slurm.concurrency == 0 {
             return Err(FieldError::new("slurm.concurrency", "must be at least 1"));
         }
-        if !is_slurm_time(&slurm.time_limit) {
+        if !super::slurm::is_slurm_time(&slurm.time_limit) {
             return Err(FieldError::new(
                 "slurm.time_limit",
                 format!(
                     "{:?} is not a Slurm time such as \"30:00\", \"01:00:00\" or \"2-00:00:00\"",
                     slurm.time_limit
-                ),
-            ));
-        }
-        Ok(())
-    }
-
-    /// The `eos` figure draws z against the area fraction, the mean over seeds with its
-    /// standard error: the spec varies those two and nothing else.
-    fn check_eos_figure(&self) -> Result<(), FieldError> {
-        let axis = |f: fn(&Axis) -> bool| self.axes.iter().find(|a| f(a)).map_or(0, Axis::len);
-        if axis(|a| matches!(a, Axis::AreaFraction(_))) == 0 {
-            return Err(FieldError::new(
-                "figure",
-                "`eos` draws z against area fraction: the spec needs an `area_fraction` axis",
-            ));
-        }
-        if axis(|a| matches!(a, Axis::Seed(_))) < 2 || self.combine == Combine::Zip {
-            return Err(FieldError::new(
-                "figure",
-                "`eos` draws the standard error over seeds: the spec needs a `seed` axis of two \
-                 or more, combined by `product`",
-            ));
-        }
-        let other = self
-            .axes
-            .iter()
-            .position(|a| !matches!(a, Axis::AreaFraction(_) | Axis::Seed(_)) && a.len() > 1);
-        if let Some(k) = other {
-            return Err(FieldError::new(
-                "figure",
-                format!(
-                    "`eos` averages over seeds alone, but axes[{k}] varies {} too: sweep each \
-                     of its values in a spec of its own",
-                    self.axes[k].sets()
                 ),
             ));
         }
@@ -421,15 +355,4 @@ impl SweepSpec {
             })
             .collect()
     }
-}
-
-/// Whether `s` is a Slurm time limit: `M`, `M:S`, `H:M:S`, `D-H`, `D-H:M` or `D-H:M:S`.
-fn is_slurm_time(s: &str) -> bool {
-    let (days, clock) = match s.split_once('-') {
-        Some((d, rest)) => (Some(d), rest),
-        None => (None, s),
-    };
-    let numbers = |t: &str| !t.is_empty() && t.len() <= 4 && t.bytes().all(|b| b.is_ascii_digit());
-    let parts: Vec<&str> = clock.split(':').collect();
-    days.is_none_or(numbers) && parts.len() <= 3 && parts.iter().all(|p| numbers(p))
 }

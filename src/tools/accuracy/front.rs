@@ -46,6 +46,10 @@ pub const MEASURES: [Measure; 5] = [
     },
 ];
 
+/// The measures a run's report carries (no trajectory needed), the first three of
+/// [`MEASURES`]: what a sweep's merge can draw.
+pub const REPORT_MEASURES: [Measure; 3] = [MEASURES[0], MEASURES[1], MEASURES[2]];
+
 /// Indices of the points on the Pareto front of `(cost, error)`, cheapest first: each has a
 /// smaller error than every cheaper point. Of equally cheap points only the most accurate
 /// can be on it. Points with a cost or error that is not a number are never on it.

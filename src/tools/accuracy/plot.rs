@@ -1,5 +1,6 @@
 //! The study's figure ([`AccuracyFigure`], as SVG and PNG): a row
-//! of panels per scene, one panel per error measure ([`MEASURES`]), each plotting error
+//! of panels per scene, one panel per error measure (the study's [`MEASURES`], or the
+//! [`REPORT_MEASURES`] a sweep's reports carry), each plotting error
 //! against cost (ms per simulated second) on log axes. A line joins one solver's runs at 30, 60 and 120 Hz
 //! (marker shape gives the rate), the `exact` reference is a dashed vertical line at its cost
 //! (error 0 by definition), errors of exactly 0 sit on the axis's bottom line labelled `0`,
@@ -8,12 +9,17 @@
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 
-use super::front::{MEASURES, Measure, Panel, cost, of_scene, rate, scenes};
+#[cfg(doc)]
+use super::front::{MEASURES, REPORT_MEASURES};
+use super::front::{Measure, Panel, cost, of_scene, rate, scenes};
 use super::measure::Row;
 use crate::tools::figure::{Figure, decades, err, font};
 
-/// The figure's size in pixels (SVG user units and PNG pixels alike).
-pub const FIGURE_SIZE: (u32, u32) = (1600, 1290);
+/// The figure's width in pixels (SVG user units and PNG pixels alike).
+pub const FIGURE_WIDTH: u32 = 1600;
+
+/// The height of each scene's row of panels.
+pub const ROW_HEIGHT: u32 = 232;
 
 /// Height of the title and legend strip above the panels.
 const STRIP: u32 = 130;
@@ -36,32 +42,57 @@ const EXACT: RGBColor = SETTINGS[SETTINGS.len() - 1].1;
 const FRONT: RGBColor = RGBColor(255, 200, 60);
 const GRID: RGBColor = RGBColor(225, 225, 225);
 
-/// The study's figure for `rows`.
-pub struct AccuracyFigure<'a>(pub &'a [Row]);
+/// The figure of `rows`: a row of panels per scene, a panel per measure; `note` is the
+/// legend's second line (what the points are, and when position errors were taken).
+pub struct AccuracyFigure<'a> {
+    /// The rows, each a setting of a scene.
+    pub rows: &'a [Row],
+    /// The measures, one panel each, left to right.
+    pub measures: &'a [Measure],
+    /// The second line of the legend.
+    pub note: String,
+}
+
+impl<'a> AccuracyFigure<'a> {
+    /// The study's figure: its five measures, the note naming the horizons.
+    pub fn study(rows: &'a [Row]) -> Self {
+        Self {
+            rows,
+            measures: &super::front::MEASURES,
+            note: horizons(rows),
+        }
+    }
+
+    /// Its size in pixels: [`FIGURE_WIDTH`] wide, [`ROW_HEIGHT`] a scene below the legend.
+    pub fn size_for(scenes: usize) -> (u32, u32) {
+        (FIGURE_WIDTH, STRIP + ROW_HEIGHT * scenes.max(1) as u32)
+    }
+}
 
 impl Figure for AccuracyFigure<'_> {
     fn size(&self) -> (u32, u32) {
-        FIGURE_SIZE
+        Self::size_for(scenes(self.rows).len())
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let rows = self.0;
+        let rows = self.rows;
         let (strip, grid) = root.split_vertically(STRIP);
-        legend(&strip, rows)?;
+        legend(&strip, &self.note)?;
         let scenes = scenes(rows);
-        let panels = grid.split_evenly((scenes.len().max(1), MEASURES.len()));
+        let columns = self.measures.len().max(1);
+        let panels = grid.split_evenly((scenes.len().max(1), columns));
         for (s, scene) in scenes.iter().enumerate() {
             let mine = of_scene(rows, scene);
-            for (m, measure) in MEASURES.iter().enumerate() {
-                panel(&panels[s * MEASURES.len() + m], &mine, measure)?;
+            for (m, measure) in self.measures.iter().enumerate() {
+                panel(&panels[s * columns + m], &mine, measure)?;
             }
         }
         Ok(())
     }
 }
 
-/// The title and the legend: settings, rates, the reference and the front.
-fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, rows: &[Row]) -> Result<(), String> {
+/// The study's note: when its position errors were taken.
+fn horizons(rows: &[Row]) -> String {
     let mut horizons: Vec<(f64, Vec<&str>)> = Vec::new();
     for r in rows {
         match horizons.iter_mut().find(|(h, _)| *h == r.horizon) {
@@ -74,17 +105,22 @@ fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, rows: &[Row]) -> R
         .iter()
         .map(|(h, scenes)| format!("{h} s ({})", scenes.join(", ")))
         .collect();
+    format!(
+        "Position error is measured after {} (a few collisions per circle; later, chaos saturates it near one radius for every discrete solver). 0 on an axis: no error at all.",
+        horizons.join(" and ")
+    )
+}
+
+/// The title and the legend: settings, rates, the reference and the front; `note` is the
+/// second line.
+fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, note: &str) -> Result<(), String> {
     let lines = [
-        "What accuracy costs: error against exact (y) vs CPU ms of stepping per simulated second (x), log axes; lower left is better."
-            .to_owned(),
-        format!(
-            "Position error is measured after {} (a few collisions per circle; later, chaos saturates it near one radius for every discrete solver). 0 on an axis: no error at all.",
-            horizons.join(" and ")
-        ),
+        "What accuracy costs: error against exact (y) vs CPU ms of stepping per simulated second (x), log axes; lower left is better.",
+        note,
     ];
     for (i, line) in lines.iter().enumerate() {
         strip
-            .draw(&Text::new(line.as_str(), (14, 8 + 22 * i as i32), font(16)))
+            .draw(&Text::new(*line, (14, 8 + 22 * i as i32), font(16)))
             .map_err(err)?;
     }
     let row_y = 66;

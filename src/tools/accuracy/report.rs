@@ -1,7 +1,7 @@
 //! The study's results as text: the fixed-width table the command prints and the Pareto fronts
 //! (the CSV, one column per [`Row`] field, is written by [`crate::tools::io::csv_text`]).
 
-use super::front::{MEASURES, Panel, of_scene, scenes};
+use super::front::{Measure, Panel, of_scene, scenes};
 use super::measure::Row;
 
 /// The study as a fixed-width table.
@@ -43,16 +43,16 @@ pub fn to_table(rows: &[Row]) -> String {
     out
 }
 
-/// Each scene's Pareto front per measure, one line each: the settings, cheapest first, that
-/// are more accurate than every cheaper one, ending at the reference. What to pick for an
-/// error budget is the first setting within it.
-pub fn to_fronts(rows: &[Row]) -> String {
+/// Each scene's Pareto front per measure of `measures`, one line each: the settings,
+/// cheapest first, that are more accurate than every cheaper one, ending at the reference.
+/// What to pick for an error budget is the first setting within it.
+pub fn to_fronts(rows: &[Row], measures: &[Measure]) -> String {
     let mut out = String::from(
         "Pareto fronts (cheapest first; ms of stepping per simulated second, then the error):\n",
     );
     for scene in scenes(rows) {
         let mine = of_scene(rows, scene);
-        for measure in &MEASURES {
+        for measure in measures {
             let front: Vec<String> = Panel::new(&mine, measure)
                 .front()
                 .iter()

@@ -87,7 +87,13 @@ impl EosOptions {
         if self.area_fractions.is_empty() {
             return Err(FieldError::new("--area-fractions", "none given"));
         }
-        for &phi in &self.area_fractions {
+        for (k, &phi) in self.area_fractions.iter().enumerate() {
+            if self.area_fractions[..k].contains(&phi) {
+                return Err(FieldError::new(
+                    "--area-fractions",
+                    format!("{phi} is given twice"),
+                ));
+            }
             if !(phi > 0.0 && phi <= MAX_AREA_FRACTION) {
                 return Err(FieldError::new(
                     "--area-fractions",
