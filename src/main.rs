@@ -43,6 +43,9 @@ enum Command {
         /// One step size and shorter runs: a smoke test of the study, not a measurement.
         #[arg(long)]
         quick: bool,
+        /// Runs at once, each a process (default: the cores).
+        #[arg(long, value_name = "K")]
+        jobs: Option<usize>,
     },
     /// Measure the hard-disk equation of state under `exact`: Z against area fraction in a
     /// periodic box, with block error bars, against Henderson's and Liu's equations; prints a
@@ -337,8 +340,14 @@ fn main() -> ExitCode {
             SweepCommand::Status { dir } => cli::sweep::status(&dir).map(|()| 0),
             SweepCommand::Merge { dir } => cli::sweep::merge(&dir).map(|()| 0),
         },
-        Some(Command::Accuracy { out, scenes, quick }) => {
-            cli::accuracy::accuracy(&out, &scenes, quick).map(|()| 0)
+        Some(Command::Accuracy {
+            out,
+            scenes,
+            quick,
+            jobs,
+        }) => {
+            let jobs = jobs.unwrap_or_else(cores);
+            cli::accuracy::accuracy(&out, &scenes, quick, jobs).map(|()| 0)
         }
         Some(Command::Eos {
             out,
@@ -359,9 +368,7 @@ fn main() -> ExitCode {
                 block,
                 seed,
             };
-            let jobs = jobs.unwrap_or_else(|| {
-                std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-            });
+            let jobs = jobs.unwrap_or_else(cores);
             cli::eos::eos(&options, &out, jobs).map(|()| 0)
         }
         None => open_app(cli.app).map(|()| 0),
@@ -397,4 +404,9 @@ fn open_app(_: AppArgs) -> anyhow::Result<()> {
         "built without the `render` feature, so there is no window; use `moving_circles run` \
          or rebuild with default features"
     )
+}
+
+/// This machine's cores: `--jobs` when not given.
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
 }

@@ -408,6 +408,63 @@ fn an_accuracy_sweep_draws_each_settings_cost_against_its_errors() {
 }
 
 #[test]
+fn a_trace_sweep_is_the_accuracy_study_of_its_scene_and_a_pile_sweep_its_pile_rows() {
+    let dir = scratch_dir("sweep", "study");
+    let spec = spec_file(
+        &dir,
+        &format!(
+            r#"(scene: "{}", length: seconds(0.3), measure: trace(horizon: 0.1),
+                axes: [solver(["discrete", "exact"]), dt([0.016666666666666666])],
+                figure: Some(accuracy))"#,
+            gas1k()
+        ),
+    );
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    successful(&["sweep", "plan", &spec, "--out", out]);
+    successful(&["sweep", "run", out, "--jobs", "2"]);
+    // The study's rows: `exact` at 60 Hz is the reference (no error); `discrete` is not.
+    let csv = std::fs::read_to_string(dir.join("out/accuracy.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let cell = |solver: &str, column: &str| -> f64 {
+        let k = header.iter().position(|&h| h == column).unwrap();
+        let line = csv
+            .lines()
+            .find(|l| l.split(',').nth(2) == Some(solver))
+            .unwrap_or_else(|| panic!("no {solver} row: {csv}"));
+        line.split(',').nth(k).unwrap().parse().unwrap()
+    };
+    assert_eq!(cell("exact", "position_error"), 0.0, "{csv}");
+    assert!(cell("discrete", "position_error") > 0.0, "{csv}");
+    assert!(cell("discrete", "max_penetration") > 0.0, "{csv}");
+    // All five of the study's measures are drawn.
+    let drawing = std::fs::read_to_string(dir.join("out/accuracy.svg")).unwrap();
+    for measure in moving_circles::tools::accuracy::front::MEASURES {
+        assert!(
+            drawing.contains(measure.title),
+            "no panel of {}",
+            measure.title
+        );
+    }
+    let pyramid = format!("{}/assets/scenes/pyramid.ron", env!("CARGO_MANIFEST_DIR"));
+    let spec = spec_file(
+        &dir,
+        &format!(
+            r#"(scene: "{pyramid}", length: seconds(0.5), measure: pile,
+                axes: [solver(["discrete", "soft"])])"#
+        ),
+    );
+    let piles = dir.join("piles");
+    let piles = piles.to_str().unwrap();
+    successful(&["sweep", "plan", &spec, "--out", piles]);
+    successful(&["sweep", "run", piles, "--jobs", "2"]);
+    let csv = std::fs::read_to_string(dir.join("piles/piles.csv")).unwrap();
+    assert!(csv.starts_with("scene,n,solver,dt,"), "{csv}");
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn hostile_specs_are_refused_naming_the_field() {
     let scene = gas1k();
     let cases = [
@@ -460,8 +517,12 @@ fn hostile_specs_are_refused_naming_the_field() {
             "a `solver` axis that includes \"exact\"",
         ),
         (
-            r#"axes: [solver(["discrete", "exact"]), dt([0.01, 0.02])], figure: Some(accuracy)"#,
-            "needs 0.016666666666666666 (1/60)",
+            r#"axes: [solver(["discrete", "exact"])], figure: Some(accuracy)"#,
+            "`accuracy` compares runs over the same simulated time",
+        ),
+        (
+            r#"axes: [solver(["soft", "soft=4"])]"#,
+            "axes[0].solver[1]: repeats axes[0].solver[0]",
         ),
     ];
     // A billion tasks: three axes of a thousand values.
@@ -511,6 +572,38 @@ fn hostile_specs_are_refused_naming_the_field() {
             r#"(measure: eos(n: 100))"#.to_owned(),
             "axes: the `eos` measure needs",
         ),
+        (
+            r#"(measure: eos(n: 100), axes: [area_fraction([0.3])], dump: true)"#.to_owned(),
+            "dump: only the `report` measure",
+        ),
+        (
+            format!(
+                r#"(scene: "{scene}", length: seconds(1.0), figure: Some(accuracy),
+                    axes: [solver(["discrete", "exact"]), dt([0.01, 0.02])])"#
+            ),
+            "needs 0.016666666666666666 (1/60)",
+        ),
+        (
+            format!(r#"(scene: "{scene}", length: steps(10), measure: trace(horizon: 0.1))"#),
+            "length: the `trace` measure runs for a time",
+        ),
+        (
+            format!(r#"(scene: "{scene}", length: seconds(1.0), measure: trace(horizon: 2.0))"#),
+            "measure.trace.horizon: must be above 0 and at most the length",
+        ),
+        (
+            format!(
+                r#"(scene: "{scene}", length: seconds(1.0), measure: pile, axes: [seed([1, 2])])"#
+            ),
+            "axes[0]: the `pile` measure varies `solver` and `dt` alone, not `seed`",
+        ),
+        (
+            format!(
+                r#"(scene: "{scene}", length: seconds(1.0), measure: pile, figure: Some(accuracy),
+                    axes: [solver(["exact"])])"#
+            ),
+            "figure: draws what this measure does not measure",
+        ),
     ] {
         let error = SweepSpec::parse(&text, "s.ron").unwrap_err();
         assert!(error.contains(expected), "{text}: {error}");
@@ -530,8 +623,27 @@ fn a_folder_holding_another_sweeps_plan_is_refused() {
         ),
     );
     successful(&["sweep", "plan", &first, "--out", out]);
-    // The same spec again: nothing to do.
+    // The same spec again: nothing to do; also when the plan was written in other words (as
+    // an earlier version wrote it: no extensions, `Some(...)`, no `measure`).
     successful(&["sweep", "plan", &first, "--out", out]);
+    let planned = dir.join("out/spec.ron");
+    let text = std::fs::read_to_string(&planned).unwrap();
+    let older: String = text
+        .lines()
+        .filter(|l| !l.starts_with("#!") && !l.contains("measure:"))
+        .map(|l| match l.trim_start().strip_prefix("scene: ") {
+            Some(path) => format!("    scene: Some({}),\n", path.trim_end_matches(',')),
+            None => format!("{l}\n"),
+        })
+        .collect();
+    assert_ne!(older, text);
+    std::fs::write(&planned, older).unwrap();
+    let again = successful(&["sweep", "plan", &first, "--out", out]);
+    assert!(
+        stdout(&again).contains("holds this sweep's plan already"),
+        "{}",
+        stdout(&again)
+    );
     let second = spec_file(
         &dir,
         &format!(

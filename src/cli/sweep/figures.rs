@@ -153,7 +153,12 @@ pub(super) fn accuracy(rows: &[Value], spec: &SweepSpec, dir: &Path) -> anyhow::
         ),
     };
     to_fronts(&rows, &REPORT_MEASURES).lines().for_each(say);
-    let [vector, picture] = draw(&figure, dir, "accuracy")?;
+    draw_accuracy(&figure, dir)
+}
+
+/// Draws `figure` into `accuracy.svg` and `accuracy.png` in `dir`, and says so.
+pub(super) fn draw_accuracy(figure: &AccuracyFigure, dir: &Path) -> anyhow::Result<()> {
+    let [vector, picture] = draw(figure, dir, "accuracy")?;
     say(format_args!(
         "drew what accuracy costs into {} and {}",
         vector.display(),
@@ -219,7 +224,7 @@ pub(super) fn accuracy_rows(rows: &[Value], stem: &str) -> anyhow::Result<Vec<Ro
     let names = case_names(&cases, stem);
     let mut out = Vec::new();
     for ((c, solver, dt), members) in &groups {
-        let mut sums = [0.0; 7];
+        let mut sums = [0.0; 8];
         let mut z_errors = Vec::new();
         let mut zs = Vec::new();
         for row in members {
@@ -246,6 +251,7 @@ pub(super) fn accuracy_rows(rows: &[Value], stem: &str) -> anyhow::Result<Vec<Ro
                 number(row, "mean_penetration")?,
                 number(row, "energy_drift")?,
                 number(row, "n")?,
+                collisions,
             ];
             for (sum, value) in sums.iter_mut().zip(values) {
                 *sum += value;
@@ -277,7 +283,7 @@ pub(super) fn accuracy_rows(rows: &[Value], stem: &str) -> anyhow::Result<Vec<Ro
             mean_penetration: sums[4] / k,
             tunnelled: 0,
             escaped: 0,
-            pair_collisions: number(first, "pair_collisions")? as u64,
+            pair_collisions: (sums[7] / k).round() as u64,
             collision_error: sums[2] / k,
             z: mean(&zs),
             z_error: mean(&z_errors),

@@ -96,8 +96,13 @@ pub fn run(dir: &Path, jobs: usize) -> anyhow::Result<()> {
     }
     if !failed.is_empty() {
         failed.sort_unstable();
+        // The first failure's own words, so that one failing task says why at once.
+        let why = std::fs::read_to_string(folder.failure(failed[0])).unwrap_or_default();
         bail!(
-            "tasks {failed:?} failed: `moving_circles sweep status {}` says why",
+            "tasks {failed:?} failed (task {}: {}): `moving_circles sweep status {}` says why \
+             for each",
+            failed[0],
+            why.lines().next().unwrap_or("see its log"),
             dir.display()
         );
     }

@@ -1,5 +1,6 @@
-//! What each task of a sweep measures: the report of a `run` of the scene (the default), or a
-//! point of the hard-disk equation of state, measured as `moving_circles eos` measures one.
+//! What each task of a sweep measures: the report of a `run` of the scene (the default), a
+//! point of the hard-disk equation of state (as `moving_circles eos` measures one), or a run
+//! of the accuracy study (as `moving_circles accuracy` measures one, gas or pile).
 
 use serde::{Deserialize, Serialize};
 
@@ -19,6 +20,19 @@ pub enum TaskMeasure {
     /// then `Z` measured in blocks (`crate::tools::eos::measure`). The spec names no scene and
     /// no length; the result is an `eos.csv` row. A task stopped before it ends starts again.
     Eos(EosMeasure),
+    /// A run of the accuracy study under the task's solver and step: its report, and beside it
+    /// (`results/I.trace`) its circles at `horizon` seconds and at the end and the pairs that
+    /// passed through each other, which `merge` compares with the `exact` task at 60 Hz
+    /// (`accuracy.csv`, and the study's five measures in the `accuracy` figure). The spec
+    /// varies `solver` and `dt` alone and runs for `seconds(T)`.
+    Trace {
+        /// When positions are compared, in simulated seconds (the study's 0.1).
+        horizon: f64,
+    },
+    /// A pile run of the accuracy study under the task's solver and step: overlap at rest,
+    /// energy left, time to settle, cost (a `piles.csv` row). The spec varies `solver` and
+    /// `dt` alone and runs for `seconds(T)`.
+    Pile,
 }
 
 /// How an `eos` task measures: the `eos` command's options but the area fractions and seed,

@@ -5,9 +5,13 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 
-use super::spec::SweepFigure;
-use super::{Plan, figures};
-use crate::tools::io::{read_limited, say, write_atomically};
+use super::spec::{SweepFigure, TaskMeasure};
+use super::{Plan, figures, pile_rows, trace_rows};
+use crate::tools::accuracy::front::MEASURES;
+use crate::tools::accuracy::piles::pile_table;
+use crate::tools::accuracy::plot::AccuracyFigure;
+use crate::tools::accuracy::report::to_fronts;
+use crate::tools::io::{csv_text, read_limited, say, write_atomically};
 
 /// `sweep merge`: every task's settings and report as one row, into `merged.csv` and
 /// `merged.json` in the sweep's folder; every task must be done.
@@ -56,11 +60,38 @@ pub fn merge(dir: &Path) -> anyhow::Result<()> {
         csv_path.display(),
         json_path.display()
     ));
+    match plan.spec.measure {
+        // The study's own rows, and its figure with all five of its measures.
+        TaskMeasure::Trace { .. } => {
+            let rows = trace_rows(dir)?;
+            write_csv(&rows, &dir.join("accuracy.csv"))?;
+            if plan.spec.figure == Some(SweepFigure::Accuracy) {
+                to_fronts(&rows, &MEASURES).lines().for_each(say);
+                figures::draw_accuracy(&AccuracyFigure::study(&rows), dir)?;
+            }
+            return Ok(());
+        }
+        TaskMeasure::Pile => {
+            let rows = pile_rows(dir)?;
+            pile_table(&rows).lines().for_each(say);
+            return write_csv(&rows, &dir.join("piles.csv"));
+        }
+        TaskMeasure::Report | TaskMeasure::Eos(_) => {}
+    }
     match plan.spec.figure {
         Some(SweepFigure::Eos) => figures::eos(&rows, dir)?,
         Some(SweepFigure::Accuracy) => figures::accuracy(&rows, &plan.spec, dir)?,
         None => {}
     }
+    Ok(())
+}
+
+/// Writes `rows` as CSV at `path`, atomically, and says so.
+fn write_csv<T: serde::Serialize>(rows: &[T], path: &Path) -> anyhow::Result<()> {
+    let text = csv_text(rows).context("formatting the CSV")?;
+    write_atomically(path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    say(format_args!("wrote {}", path.display()));
     Ok(())
 }
 

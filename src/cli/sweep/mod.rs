@@ -19,10 +19,12 @@ mod merge;
 mod slurm;
 pub mod spec;
 mod spec_rules;
+mod study;
 mod task;
 
 pub use local::run;
 pub use merge::merge;
+pub(crate) use study::{pile_rows, trace_rows};
 
 use std::path::{Path, PathBuf};
 
@@ -33,7 +35,7 @@ use crate::tools::checkpoint::Checkpoint;
 use crate::tools::eos::{EosOptions, measure};
 use crate::tools::io::{read_limited, say, write_atomically};
 use crate::tools::scene::Scene;
-use spec::{EosMeasure, MAX_SPEC_BYTES, SpecLength, SweepSpec, Task, TaskMeasure};
+use spec::{EosMeasure, SpecLength, SweepSpec, Task, TaskMeasure};
 
 /// The files and folders of a planned sweep.
 struct Folder {
@@ -67,6 +69,12 @@ impl Folder {
     }
     fn kept_dump(&self, index: usize) -> PathBuf {
         self.dir.join("results").join(format!("{index}.dump.txt"))
+    }
+    fn trace(&self, index: usize) -> PathBuf {
+        self.dir.join("results").join(format!("{index}.trace"))
+    }
+    fn trace_under_way(&self, index: usize) -> PathBuf {
+        self.dir.join("work").join(format!("{index}.trace"))
     }
     fn log(&self, index: usize) -> PathBuf {
         self.dir.join("logs").join(format!("{index}.log"))
@@ -150,7 +158,9 @@ pub(crate) fn plan_spec(
     let base = match &spec.scene {
         Some(scene) => {
             let base = Scene::read(scene)?;
-            base.to_config(&scene.display().to_string())?;
+            let config = base.to_config(&scene.display().to_string())?;
+            spec.check_scene_step(config.dt)
+                .map_err(|e| anyhow::anyhow!("{origin}: {e}"))?;
             Some(base)
         }
         None => None,
@@ -163,9 +173,11 @@ pub(crate) fn plan_spec(
     let folder = Folder {
         dir: out.to_owned(),
     };
-    if let Ok(file) = std::fs::File::open(folder.spec()) {
-        let planned = read_limited(file, MAX_SPEC_BYTES).map_err(anyhow::Error::msg)?;
-        if planned == text {
+    if folder.spec().exists() {
+        // Compared as specs, not as text: a plan written by another version in other words
+        // is the same plan.
+        let planned = SweepSpec::read(&folder.spec()).map_err(anyhow::Error::msg)?;
+        if planned == *spec {
             say(format_args!(
                 "{} holds this sweep's plan already",
                 out.display()
@@ -173,8 +185,8 @@ pub(crate) fn plan_spec(
             return Ok(None);
         }
         bail!(
-            "{} holds another sweep's plan (its spec.ron differs from {origin}): plan into an \
-             empty folder, or remove that one",
+            "{} holds another sweep's plan (its spec.ron differs from {origin}): use another \
+             folder, or remove that one",
             out.display(),
         );
     }
@@ -237,13 +249,21 @@ pub fn task(dir: &Path, index: Option<usize>) -> anyhow::Result<Finished> {
     let outcome = match &plan.spec.measure {
         TaskMeasure::Report => run_task(&plan, task),
         TaskMeasure::Eos(eos) => eos_task(folder, eos, task),
+        TaskMeasure::Trace { horizon } => study::trace_task(&plan, task, *horizon),
+        TaskMeasure::Pile => study::pile_task(&plan, task),
     };
     let outcome = outcome.and_then(|finished| {
         if finished == Finished::Completed {
-            // The dump first: a task with its report in `results/` has everything there.
+            // The dump and the trace first: a task with its report in `results/` has
+            // everything there.
             if plan.spec.dump {
                 let kept = folder.kept_dump(index);
                 std::fs::rename(folder.dump(index), &kept)
+                    .with_context(|| format!("putting {} in place", kept.display()))?;
+            }
+            if let TaskMeasure::Trace { .. } = plan.spec.measure {
+                let kept = folder.trace(index);
+                std::fs::rename(folder.trace_under_way(index), &kept)
                     .with_context(|| format!("putting {} in place", kept.display()))?;
             }
             std::fs::rename(folder.report(index), &result)

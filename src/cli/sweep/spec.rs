@@ -182,7 +182,11 @@ impl Axis {
         }
         // A value given twice is a typo, and would weigh twice in a mean over the axis.
         let repeat = match self {
-            Self::Solver(v) => first_repeat(v.iter()),
+            // `soft` and `soft=4` are one solver.
+            Self::Solver(v) => first_repeat(
+                v.iter()
+                    .map(|n| n.parse::<Solver>().map_or(n.clone(), |s| s.to_string())),
+            ),
             Self::Dt(v) | Self::AreaFraction(v) => first_repeat(v.iter().map(|x| x.to_bits())),
             Self::Seed(v) | Self::Steps(v) => first_repeat(v.iter()),
             Self::Field(_, v) => first_repeat(v.iter()),

@@ -1,7 +1,7 @@
 //! The rules that tie a spec's fields together: what its measure and its figure need of its
 //! scene, length and axes.
 
-use super::spec::{Axis, Combine, SweepSpec, TaskMeasure};
+use super::spec::{Axis, Combine, SpecLength, SweepFigure, SweepSpec, TaskMeasure};
 use crate::base::config::Solver;
 use crate::base::error::FieldError;
 
@@ -9,6 +9,34 @@ impl SweepSpec {
     /// The `report` measure runs the scene for the length; the `eos` measure places its own
     /// disks, runs until it has its collisions, and varies only area fraction and seed.
     pub(super) fn check_measure(&self) -> Result<(), FieldError> {
+        let figure_fits = matches!(
+            (self.figure, &self.measure),
+            (None, _)
+                | (
+                    Some(SweepFigure::Eos),
+                    TaskMeasure::Report | TaskMeasure::Eos(_)
+                )
+                | (
+                    Some(SweepFigure::Accuracy),
+                    TaskMeasure::Report | TaskMeasure::Trace { .. }
+                )
+        );
+        if !figure_fits {
+            return Err(FieldError::new(
+                "figure",
+                "draws what this measure does not measure: `eos` needs the `report` or `eos` \
+                 measure, `accuracy` the `report` or `trace` measure",
+            ));
+        }
+        if self.dump && self.measure != TaskMeasure::Report {
+            return Err(FieldError::new(
+                "dump",
+                "only the `report` measure's tasks are runs that end in a state to keep",
+            ));
+        }
+        if matches!(self.measure, TaskMeasure::Trace { .. } | TaskMeasure::Pile) {
+            return self.check_study_measure();
+        }
         let TaskMeasure::Eos(eos) = &self.measure else {
             if self.scene.is_none() {
                 return Err(FieldError::new("scene", "missing: the scene the tasks run"));
@@ -57,6 +85,45 @@ impl SweepSpec {
         Ok(())
     }
 
+    /// The `trace` and `pile` measures run the scene under each solver and step for a time.
+    fn check_study_measure(&self) -> Result<(), FieldError> {
+        let name = match self.measure {
+            TaskMeasure::Trace { .. } => "trace",
+            _ => "pile",
+        };
+        if self.scene.is_none() {
+            return Err(FieldError::new("scene", "missing: the scene the tasks run"));
+        }
+        let Some(SpecLength::Seconds(seconds)) = self.length else {
+            return Err(FieldError::new(
+                "length",
+                format!("the `{name}` measure runs for a time: give `seconds(T)`"),
+            ));
+        };
+        if let TaskMeasure::Trace { horizon } = self.measure
+            && !(horizon > 0.0 && horizon <= seconds)
+        {
+            return Err(FieldError::new(
+                "measure.trace.horizon",
+                format!("must be above 0 and at most the length, {seconds} s; got {horizon}"),
+            ));
+        }
+        if let Some(k) = self
+            .axes
+            .iter()
+            .position(|a| !matches!(a, Axis::Solver(_) | Axis::Dt(_)))
+        {
+            return Err(FieldError::new(
+                format!("axes[{k}]"),
+                format!(
+                    "the `{name}` measure varies `solver` and `dt` alone, not {}",
+                    self.axes[k].sets()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// The `eos` figure draws z against the area fraction, the mean over seeds with its
     /// standard error (or, with the `eos` measure and one seed, its blocks' error): the spec
     /// varies those two and nothing else.
@@ -74,13 +141,17 @@ impl SweepSpec {
         } else {
             1
         };
-        if axis(|a| matches!(a, Axis::Seed(_))).max(1) < seeds_needed
-            || self.combine == Combine::Zip
-        {
+        if self.combine == Combine::Zip {
+            return Err(FieldError::new(
+                "figure",
+                "`eos` groups the tasks by area fraction: combine the axes by `product`",
+            ));
+        }
+        if axis(|a| matches!(a, Axis::Seed(_))).max(1) < seeds_needed {
             return Err(FieldError::new(
                 "figure",
                 "`eos` draws the standard error over seeds: the spec needs a `seed` axis of two \
-                 or more, combined by `product`",
+                 or more",
             ));
         }
         let other = self
@@ -94,6 +165,22 @@ impl SweepSpec {
                     "`eos` averages over seeds alone, but axes[{k}] varies {} too: sweep each \
                      of its values in a spec of its own",
                     self.axes[k].sets()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Without a `dt` axis the tasks run at the scene's step, `dt`: the `accuracy` figure
+    /// needs it to be 1/60 s.
+    pub(super) fn check_scene_step(&self, dt: f64) -> Result<(), FieldError> {
+        let dt_axis = self.axes.iter().any(|a| matches!(a, Axis::Dt(_)));
+        if self.figure == Some(SweepFigure::Accuracy) && !dt_axis && !is_reference_dt(dt) {
+            return Err(FieldError::new(
+                "figure",
+                format!(
+                    "`accuracy` compares each setting with `exact` at 60 Hz, and the scene's \
+                     step is {dt} s: add a `dt` axis with 0.016666666666666666 (1/60)"
                 ),
             ));
         }
@@ -115,6 +202,14 @@ impl SweepSpec {
                     "`accuracy` compares each setting with `{exact}`: the spec needs a `solver` \
                      axis that includes \"{exact}\", combined by `product`"
                 ),
+            ));
+        }
+        let steps_axis = self.axes.iter().any(|a| matches!(a, Axis::Steps(_)));
+        if steps_axis || matches!(self.length, Some(SpecLength::Steps(_))) {
+            return Err(FieldError::new(
+                "figure",
+                "`accuracy` compares runs over the same simulated time: give `length: \
+                 seconds(T)` and no `steps` axis (steps of different sizes cover different times)",
             ));
         }
         let dts = self.axes.iter().find_map(|a| match a {

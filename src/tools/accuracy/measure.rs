@@ -20,7 +20,7 @@
 //! - cost: `ms_per_step` and `ms_per_sim_second` of stepping alone.
 
 use bevy::math::DVec2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::base::arena::Arena;
 use crate::base::circle::{CircleState, snapshot};
@@ -64,7 +64,7 @@ pub struct Case {
 }
 
 /// What one run did, before it is compared with the reference.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Trace {
     /// Solver used.
     pub solver: Solver,

@@ -24,25 +24,17 @@ pub use measure::{
     Case, HORIZON_SECONDS, REFERENCE_DT, Row, SOLVERS, Trace, compare, passed_through, trace,
 };
 
-use crate::base::config::{CirclesConfig, Solver};
+use crate::base::config::CirclesConfig;
 use crate::base::error::InputError;
 use crate::tools::scene::Scene;
 
-/// The solvers and steps every case is run with: one step size when `quick`.
-pub fn settings(quick: bool) -> Vec<(Solver, f64)> {
-    each_solver_and_step(&SOLVERS, quick)
-}
-
-/// Every one of `solvers` at 30, 60 and 120 Hz, or at 60 Hz alone when `quick`.
-fn each_solver_and_step(solvers: &[Solver], quick: bool) -> Vec<(Solver, f64)> {
-    let dts: &[f64] = if quick {
+/// The study's steps: 30, 60 and 120 Hz, or 60 Hz alone when `quick`.
+pub fn steps(quick: bool) -> &'static [f64] {
+    if quick {
         &[1.0 / 60.0]
     } else {
         &[1.0 / 30.0, 1.0 / 60.0, 1.0 / 120.0]
-    };
-    dts.iter()
-        .flat_map(|&dt| solvers.iter().map(move |&s| (s, dt)))
-        .collect()
+    }
 }
 
 /// The scene `name` of the study from `scenes_dir`, refused if it has no circle to measure
@@ -101,29 +93,4 @@ pub fn pile_cases(scenes_dir: &Path, quick: bool) -> Result<Vec<Case>, InputErro
             })
         })
         .collect()
-}
-
-/// The solvers and steps every pile case is run with: 60 Hz alone when `quick`.
-pub fn pile_settings(quick: bool) -> Vec<(Solver, f64)> {
-    each_solver_and_step(&piles::PILE_SOLVERS, quick)
-}
-
-/// Runs every case under every setting and compares each run with the case's `exact`
-/// reference at 60 Hz ([`REFERENCE_DT`]). `progress(case, setting)` is told what runs next (`None`: the
-/// reference).
-pub fn study(
-    cases: &[Case],
-    settings: &[(Solver, f64)],
-    mut progress: impl FnMut(&Case, Option<(Solver, f64)>),
-) -> Vec<Row> {
-    let mut rows = Vec::new();
-    for case in cases {
-        progress(case, None);
-        let reference = trace(case, Solver::REFERENCE, REFERENCE_DT);
-        for &(solver, dt) in settings {
-            progress(case, Some((solver, dt)));
-            rows.push(compare(case, &trace(case, solver, dt), &reference));
-        }
-    }
-    rows
 }

@@ -12,7 +12,7 @@
 //! [`pile_picks`] reads off, per scene and overlap budget, the cheapest setting that settles
 //! within the budget at rest: what the README's "what to pick" is for piles.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::measure::Case;
 use crate::base::config::Solver;
@@ -38,7 +38,7 @@ pub const PILE_SOLVERS: [Solver; 7] = [
 pub const PILE_BUDGETS: [f64; 3] = [0.1, 0.02, 1e-9];
 
 /// One run of a pile scene.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PileRow {
     /// Scene name.
     pub scene: String,
@@ -124,22 +124,6 @@ pub fn measure_pile(case: &Case, solver: Solver, dt: f64) -> PileRow {
         escaped: report.escaped,
         budget_exhausted: report.budget_exhausted,
     }
-}
-
-/// Runs every pile case under every setting; `progress(case, setting)` is told what runs next.
-pub fn pile_study(
-    cases: &[Case],
-    settings: &[(Solver, f64)],
-    mut progress: impl FnMut(&Case, (Solver, f64)),
-) -> Vec<PileRow> {
-    let mut rows = Vec::new();
-    for case in cases {
-        for &(solver, dt) in settings {
-            progress(case, (solver, dt));
-            rows.push(measure_pile(case, solver, dt));
-        }
-    }
-    rows
 }
 
 /// Per scene and overlap budget, the cheapest setting (by ms per simulated second) that left

@@ -39,6 +39,8 @@ const SETTINGS: [(&str, RGBColor); 9] = [
 
 /// The reference's colour (the last setting, `exact`).
 const EXACT: RGBColor = SETTINGS[SETTINGS.len() - 1].1;
+/// A solver the study does not run.
+const OTHER: RGBColor = RGBColor(120, 120, 120);
 const FRONT: RGBColor = RGBColor(255, 200, 60);
 const GRID: RGBColor = RGBColor(225, 225, 225);
 
@@ -262,7 +264,14 @@ fn panel<DB: DrawingBackend>(
             ))
             .map_err(err)?;
     }
-    for (name, colour) in SETTINGS {
+    // The study's settings in their colours; any other (a sweep's `substeps=3`) in grey.
+    let mut lines: Vec<(&str, RGBColor)> = SETTINGS.to_vec();
+    for (r, _) in &plotted {
+        if !lines.iter().any(|(name, _)| *name == r.solver) {
+            lines.push((&r.solver, OTHER));
+        }
+    }
+    for (name, colour) in lines {
         let mut line: Vec<(&Row, f64)> = plotted
             .iter()
             .filter(|(r, _)| r.solver == name)

@@ -246,7 +246,7 @@ fn totals(world: &mut World) -> Totals {
 }
 
 /// What a headless run did. Field names and meanings are stable: other tools read them.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Report {
     /// Where the circles came from (scene or particle file).
     pub source: String,
