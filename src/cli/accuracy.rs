@@ -8,7 +8,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::sweep::spec::{Axis, Combine, SlurmSettings, SpecLength, SweepSpec, TaskMeasure};
+use super::sweep::spec::{
+    Axis, Combine, SlurmSettings, SpecLength, SweepFigure, SweepSpec, TaskMeasure,
+};
 use super::{prepare_out, sweep, write_results};
 use crate::base::config::Solver;
 use crate::tools::accuracy::front::MEASURES;
@@ -23,37 +25,23 @@ use crate::tools::io::{csv_text, say, write_atomically};
 pub fn accuracy(out: &Path, scenes: &Path, quick: bool, jobs: usize) -> anyhow::Result<()> {
     // Every scene read and every output checked before the first run: a bad pile scene or an
     // unwritable piles.csv must not end the study after the gases have run and been written.
-    let cases = default_cases(scenes, quick)?;
-    let pile_cases = pile_cases(scenes, quick)?;
+    let specs = study_specs(scenes, quick)?;
     prepare_out(
         out,
         &["accuracy.csv", "accuracy.svg", "accuracy.png", "piles.csv"],
     )?;
     let tasks = out.join("accuracy-tasks");
-    let mut rows = Vec::new();
-    for case in &cases {
-        let measure = TaskMeasure::Trace {
-            horizon: case.horizon,
-        };
-        let dir = run_case(scenes, case, measure, &SOLVERS, quick, &tasks, jobs)?;
-        rows.extend(sweep::trace_rows(&dir)?);
+    let (mut rows, mut piles) = (Vec::new(), Vec::new());
+    for (name, spec) in &specs {
+        let dir = run_case(name, spec, &tasks, jobs)?;
+        match spec.measure {
+            TaskMeasure::Pile => piles.extend(sweep::pile_rows(&dir)?),
+            _ => rows.extend(sweep::trace_rows(&dir)?),
+        }
     }
     to_table(&rows).lines().for_each(say);
     to_fronts(&rows, &MEASURES).lines().for_each(say);
     write_results(&rows, &AccuracyFigure::study(&rows), out, "accuracy")?;
-    let mut piles = Vec::new();
-    for case in &pile_cases {
-        let dir = run_case(
-            scenes,
-            case,
-            TaskMeasure::Pile,
-            &PILE_SOLVERS,
-            quick,
-            &tasks,
-            jobs,
-        )?;
-        piles.extend(sweep::pile_rows(&dir)?);
-    }
     // (Each pile scene's merge printed its table and picks.)
     let csv = out.join("piles.csv");
     let text = csv_text(&piles).context("formatting the CSV")?;
@@ -63,24 +51,49 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool, jobs: usize) -> anyhow::
     Ok(())
 }
 
+/// The study's sweeps, one a scene, each with its name: the gases under every solver with the
+/// `trace` measure, then the piles under the pile solvers with the `pile` measure, at the
+/// study's steps (one when `quick`), the scenes `NAME.ron` in `scenes`. With the default
+/// options these are `assets/sweeps/accuracy_study/NAME.ron`.
+pub fn study_specs(scenes: &Path, quick: bool) -> anyhow::Result<Vec<(String, SweepSpec)>> {
+    let gases = default_cases(scenes, quick)?.into_iter().map(|case| {
+        let measure = TaskMeasure::Trace {
+            horizon: case.horizon,
+        };
+        (case, measure, &SOLVERS[..])
+    });
+    let piles = pile_cases(scenes, quick)?
+        .into_iter()
+        .map(|case| (case, TaskMeasure::Pile, &PILE_SOLVERS[..]));
+    gases
+        .chain(piles)
+        .map(|(case, measure, solvers)| {
+            let spec = case_spec(scenes, &case, measure, solvers, quick)?;
+            Ok((case.name, spec))
+        })
+        .collect()
+}
+
 /// The sweep of one case, `case.name.ron` in `scenes` under each of `solvers` at each of the
-/// study's steps: planned into `tasks/NAME` and run; its folder.
-fn run_case(
+/// study's steps.
+fn case_spec(
     scenes: &Path,
     case: &Case,
     measure: TaskMeasure,
     solvers: &[Solver],
     quick: bool,
-    tasks: &Path,
-    jobs: usize,
-) -> anyhow::Result<std::path::PathBuf> {
+) -> anyhow::Result<SweepSpec> {
     let scene = scenes.join(format!("{}.ron", case.name));
     let scene = scene
         .canonicalize()
         .with_context(|| format!("{}", scene.display()))?;
+    // The command draws one figure of all its scenes; a sweep run alone draws its own.
+    let figure = matches!(measure, TaskMeasure::Trace { .. }).then_some(SweepFigure::Accuracy);
     // The steps first: the study's rows go step by step, each through every solver.
     let spec = SweepSpec {
         scene: Some(scene),
+        particles: None,
+        boundary: None,
         length: Some(SpecLength::Seconds(case.seconds)),
         measure,
         axes: vec![
@@ -89,15 +102,24 @@ fn run_case(
         ],
         combine: Combine::Product,
         slurm: SlurmSettings::default(),
-        // The study draws one figure of all its scenes.
-        figure: None,
+        figure,
         dump: false,
     };
     spec.check()
         .map_err(|e| anyhow::anyhow!("the study's {} as a sweep: {e}", case.name))?;
-    let dir = tasks.join(&case.name);
-    say(format_args!("{}:", case.name));
-    sweep::plan_spec(&spec, &format!("the study's {}", case.name), &dir)?;
+    Ok(spec)
+}
+
+/// Plans `spec`, the study's sweep of `name`, into `tasks/NAME` and runs it; its folder.
+fn run_case(
+    name: &str,
+    spec: &SweepSpec,
+    tasks: &Path,
+    jobs: usize,
+) -> anyhow::Result<std::path::PathBuf> {
+    let dir = tasks.join(name);
+    say(format_args!("{name}:"));
+    sweep::plan_spec(spec, &format!("the study's {name}"), &dir)?;
     sweep::run(&dir, jobs)?;
     Ok(dir)
 }

@@ -48,6 +48,8 @@ pub fn eos(options: &EosOptions, out: &Path, jobs: usize) -> anyhow::Result<()> 
 pub fn sweep_spec(options: &EosOptions) -> SweepSpec {
     SweepSpec {
         scene: None,
+        particles: None,
+        boundary: None,
         length: None,
         measure: TaskMeasure::Eos(EosMeasure::of_options(options)),
         axes: vec![

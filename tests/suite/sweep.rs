@@ -465,6 +465,47 @@ fn a_trace_sweep_is_the_accuracy_study_of_its_scene_and_a_pile_sweep_its_pile_ro
 }
 
 #[test]
+fn a_sweep_over_a_particle_file_reports_what_run_reports_for_it() {
+    let dir = scratch_dir("sweep", "particles");
+    let file = format!(
+        "{}/tests/data/particles/p10.txt",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let spec = spec_file(
+        &dir,
+        &format!(
+            r#"(particles: "{file}", boundary: periodic, length: steps(30),
+                axes: [solver(["discrete", "exact"])])"#
+        ),
+    );
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    successful(&["sweep", "plan", &spec, "--out", out]);
+    successful(&["sweep", "run", out, "--jobs", "2"]);
+    for (index, solver) in ["discrete", "exact"].iter().enumerate() {
+        let swept = read_report(&dir.join(format!("out/results/{index}.json")));
+        let direct = run_report(
+            "sweep",
+            "particles-direct",
+            &[
+                "run",
+                "--particles",
+                &file,
+                "--boundary",
+                "periodic",
+                "--solver",
+                solver,
+                "--steps",
+                "30",
+            ],
+        );
+        assert_eq!(swept["boundary"], "periodic");
+        assert_eq!(without_timings(swept), without_timings(direct), "{solver}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn hostile_specs_are_refused_naming_the_field() {
     let scene = gas1k();
     let cases = [
@@ -577,6 +618,23 @@ fn hostile_specs_are_refused_naming_the_field() {
             "dump: only the `report` measure",
         ),
         (
+            format!(r#"(scene: "{scene}", particles: "p.txt", length: steps(10))"#),
+            "particles: give a scene or a particle file, not both",
+        ),
+        (
+            r#"(particles: "p.txt", length: steps(10), axes: [seed([1, 2])])"#.to_owned(),
+            "axes[0]: a particle file places every circle itself: it has no `seed`",
+        ),
+        (
+            format!(r#"(scene: "{scene}", boundary: periodic, length: steps(10))"#),
+            "boundary: goes with a particle file",
+        ),
+        (
+            r#"(particles: "p.txt", measure: eos(n: 100), axes: [area_fraction([0.3])])"#
+                .to_owned(),
+            "particles: only the `report` measure runs a particle file",
+        ),
+        (
             format!(
                 r#"(scene: "{scene}", length: seconds(1.0), figure: Some(accuracy),
                     axes: [solver(["discrete", "exact"]), dt([0.01, 0.02])])"#
@@ -677,16 +735,37 @@ fn the_eos_spec_that_ships_is_the_sweep_the_eos_command_runs() {
 }
 
 #[test]
-fn the_specs_that_ship_are_valid_and_name_scenes_that_exist() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/sweeps");
-    let mut seen = 0;
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
-        let spec = SweepSpec::read(&path).unwrap();
-        if let Some(scene) = &spec.scene {
-            assert!(dir.join(scene).is_file(), "{path:?}: {scene:?}");
-        }
-        seen += 1;
+fn the_accuracy_specs_that_ship_are_the_sweeps_the_accuracy_command_runs() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let specs =
+        moving_circles::cli::accuracy::study_specs(&root.join("assets/scenes"), false).unwrap();
+    let dir = root.join("assets/sweeps/accuracy_study");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), specs.len());
+    for (name, command) in specs {
+        let path = dir.join(format!("{name}.ron"));
+        let mut shipped = SweepSpec::read(&path).unwrap();
+        // The command names its scene by its absolute path, the file relative to itself.
+        shipped.scene = shipped.scene.map(|s| dir.join(s).canonicalize().unwrap());
+        assert_eq!(shipped, command, "{}", path.display());
     }
-    assert!(seen >= 2);
+}
+
+#[test]
+fn the_specs_that_ship_are_valid_and_name_scenes_that_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/sweeps");
+    let mut seen = 0;
+    for dir in [root.clone(), root.join("accuracy_study")] {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                continue;
+            }
+            let spec = SweepSpec::read(&path).unwrap();
+            if let Some(scene) = &spec.scene {
+                assert!(dir.join(scene).is_file(), "{path:?}: {scene:?}");
+            }
+            seen += 1;
+        }
+    }
+    assert!(seen >= 9);
 }

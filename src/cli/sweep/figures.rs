@@ -136,6 +136,7 @@ pub(super) fn accuracy(rows: &[Value], spec: &SweepSpec, dir: &Path) -> anyhow::
     let stem = spec
         .scene
         .as_deref()
+        .or(spec.particles.as_deref())
         .and_then(Path::file_stem)
         .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
     let rows = accuracy_rows(rows, &stem)?;

@@ -119,14 +119,17 @@ impl Plan {
 /// `sweep plan`: checks the spec and its scene, and writes the plan into `out`.
 pub fn plan(spec_path: &Path, out: &Path) -> anyhow::Result<()> {
     let mut spec = SweepSpec::read(spec_path).map_err(anyhow::Error::msg)?;
-    if let Some(relative) = &spec.scene {
-        let scene = spec_path.parent().unwrap_or(Path::new(".")).join(relative);
-        spec.scene = Some(
-            scene
-                .canonicalize()
-                .with_context(|| format!("{}: scene: {}", spec_path.display(), scene.display()))?,
-        );
-    }
+    let folder = spec_path.parent().unwrap_or(Path::new("."));
+    let absolute = |field: &str, relative: &Path| {
+        let path = folder.join(relative);
+        path.canonicalize()
+            .with_context(|| format!("{}: {field}: {}", spec_path.display(), path.display()))
+    };
+    spec.scene = spec.scene.map(|s| absolute("scene", &s)).transpose()?;
+    spec.particles = spec
+        .particles
+        .map(|p| absolute("particles", &p))
+        .transpose()?;
     let tasks = plan_spec(&spec, &spec_path.display().to_string(), out)?;
     if let Some(tasks) = tasks {
         say(format_args!("planned {tasks} tasks in {}", out.display()));
@@ -165,6 +168,14 @@ pub(crate) fn plan_spec(
         }
         None => None,
     };
+    if let Some(path) = &spec.particles {
+        // Read once now, like a scene, not found wanting in each task.
+        crate::tools::scene::particles::read_until(
+            path,
+            spec.boundary.unwrap_or_default(),
+            || false,
+        )?;
+    }
     // Written as a spec is read: `scene: "..."`, `eos(n: 4096)`.
     let extensions = ron::extensions::Extensions::IMPLICIT_SOME
         | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES;
@@ -298,18 +309,21 @@ fn eos_task(folder: &Folder, eos: &EosMeasure, task: &Task) -> anyhow::Result<Fi
 fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
     let folder = &plan.folder;
     let checkpoint = folder.checkpoint(task.index);
-    let (Some(task_length), Some(scene)) = (task.length, &plan.spec.scene) else {
-        bail!("a `report` task has a scene and a length");
+    let Some(task_length) = task.length else {
+        bail!("a `report` task has a length");
+    };
+    let input = match (&task.scene, &plan.spec.scene, &plan.spec.particles) {
+        (Some(own), _, _) => Input::Scene(folder.dir.join(own)),
+        (None, Some(scene), _) => Input::Scene(scene.clone()),
+        (None, None, Some(particles)) => Input::Particles(particles.clone(), plan.spec.boundary),
+        (None, None, None) => bail!("a `report` task has a scene or a particle file"),
     };
     let length = match task_length {
         SpecLength::Steps(steps) => Length::Steps(steps),
         SpecLength::Seconds(seconds) => Length::Seconds(seconds),
     };
     let mut options = RunOptions {
-        input: Input::Scene(match &task.scene {
-            Some(own) => folder.dir.join(own),
-            None => scene.clone(),
-        }),
+        input,
         solver: task
             .solver
             .as_deref()

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 pub use super::measure::{EosMeasure, TaskMeasure};
 pub use super::slurm::SlurmSettings;
 pub use super::task::{SpecLength, Task};
+use crate::base::arena::Boundary;
 use crate::base::config::{DT_RANGE, Solver};
 use crate::base::error::FieldError;
 
@@ -29,6 +30,13 @@ pub struct SweepSpec {
     /// measure, which places its own disks).
     #[serde(default)]
     pub scene: Option<PathBuf>,
+    /// Instead of a scene, a particle file every task starts from (lines `x y vx vy r [m]`,
+    /// as `run --particles` reads them), relative to the spec's folder.
+    #[serde(default)]
+    pub particles: Option<PathBuf>,
+    /// A particle file's edges: `walls` (the default), `periodic` or `open`.
+    #[serde(default)]
+    pub boundary: Option<Boundary>,
     /// How long each task runs (an axis `steps` overrides it; none with the `eos` measure,
     /// which runs until it has counted its collisions).
     #[serde(default)]

@@ -37,9 +37,46 @@ impl SweepSpec {
         if matches!(self.measure, TaskMeasure::Trace { .. } | TaskMeasure::Pile) {
             return self.check_study_measure();
         }
+        if self.boundary.is_some() && self.particles.is_none() {
+            return Err(FieldError::new(
+                "boundary",
+                "goes with a particle file (`particles`); a scene sets its own arena",
+            ));
+        }
+        if self.particles.is_some() && self.measure != TaskMeasure::Report {
+            return Err(FieldError::new(
+                "particles",
+                "only the `report` measure runs a particle file; the others need a scene",
+            ));
+        }
         let TaskMeasure::Eos(eos) = &self.measure else {
-            if self.scene.is_none() {
-                return Err(FieldError::new("scene", "missing: the scene the tasks run"));
+            match (&self.scene, &self.particles) {
+                (None, None) => {
+                    return Err(FieldError::new(
+                        "scene",
+                        "missing: the scene (or `particles`, a particle file) the tasks run",
+                    ));
+                }
+                (Some(_), Some(_)) => {
+                    return Err(FieldError::new(
+                        "particles",
+                        "give a scene or a particle file, not both",
+                    ));
+                }
+                _ => {}
+            }
+            if self.particles.is_some()
+                && let Some(k) = self.axes.iter().position(|a| {
+                    matches!(a, Axis::Seed(_) | Axis::AreaFraction(_) | Axis::Field(..))
+                })
+            {
+                return Err(FieldError::new(
+                    format!("axes[{k}]"),
+                    format!(
+                        "a particle file places every circle itself: it has no {} to vary",
+                        self.axes[k].sets()
+                    ),
+                ));
             }
             if self.length.is_none() {
                 return Err(FieldError::new(
