@@ -2,7 +2,8 @@
 //! into `OUT/accuracy-tasks/NAME/` with the `trace` or `pile` measure and run `--jobs` at a
 //! time by the runner of `sweep run`); prints its table and fronts and writes `accuracy.csv`
 //! with the figure as `accuracy.svg` and `accuracy.png`, then each pile scene's table and
-//! picks, and `piles.csv`. Run again with the same options, it runs only what is missing.
+//! picks, and `piles.csv`. Stopped and run again with the same options, it runs only what is
+//! missing (a finished study is run again whole).
 
 use std::path::Path;
 
@@ -31,9 +32,23 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool, jobs: usize) -> anyhow::
         &["accuracy.csv", "accuracy.svg", "accuracy.png", "piles.csv"],
     )?;
     let tasks = out.join("accuracy-tasks");
+    // A finished study is run again (the code or the machine may have changed); an unfinished
+    // one goes on. Every scene is planned before the first runs, so that a folder holding
+    // another study's plan is refused before anything runs.
+    if specs
+        .iter()
+        .all(|(name, _)| sweep::finished(&tasks.join(name)))
+        && tasks.exists()
+    {
+        std::fs::remove_dir_all(&tasks)
+            .with_context(|| format!("removing the finished study's {}", tasks.display()))?;
+    }
+    for (name, spec) in &specs {
+        sweep::plan_spec(spec, &format!("the study's {name}"), &tasks.join(name))?;
+    }
     let (mut rows, mut piles) = (Vec::new(), Vec::new());
     for (name, spec) in &specs {
-        let dir = run_case(name, spec, &tasks, jobs)?;
+        let dir = run_case(name, &tasks, jobs)?;
         match spec.measure {
             TaskMeasure::Pile => piles.extend(sweep::pile_rows(&dir)?),
             _ => rows.extend(sweep::trace_rows(&dir)?),
@@ -110,16 +125,10 @@ fn case_spec(
     Ok(spec)
 }
 
-/// Plans `spec`, the study's sweep of `name`, into `tasks/NAME` and runs it; its folder.
-fn run_case(
-    name: &str,
-    spec: &SweepSpec,
-    tasks: &Path,
-    jobs: usize,
-) -> anyhow::Result<std::path::PathBuf> {
+/// Runs the study's sweep of `name`, planned in `tasks/NAME`; its folder.
+fn run_case(name: &str, tasks: &Path, jobs: usize) -> anyhow::Result<std::path::PathBuf> {
     let dir = tasks.join(name);
     say(format_args!("{name}:"));
-    sweep::plan_spec(spec, &format!("the study's {name}"), &dir)?;
     sweep::run(&dir, jobs)?;
     Ok(dir)
 }

@@ -1,10 +1,13 @@
 //! `moving_circles eos`: the hard-disk equation of state, each area fraction a task of a
 //! sweep (planned into `OUT/eos-tasks/` with the `eos` measure, run `--jobs` at a time by the
 //! runner of `sweep run`); prints a table and writes `eos.csv`, `eos.svg` and `eos.png`.
-//! Run again with the same options, it measures only the points not done; the same options
-//! as a spec run on Slurm unchanged (`assets/sweeps/eos.ron`).
+//! Stopped and run again with the same options, it measures only the points not done (a
+//! finished run's are measured again); the same options as a spec run on Slurm unchanged
+//! (`assets/sweeps/eos.ron`).
 
 use std::path::Path;
+
+use anyhow::Context;
 
 use super::sweep::spec::{
     Axis, Combine, EosMeasure, SlurmSettings, SweepFigure, SweepSpec, TaskMeasure,
@@ -23,6 +26,12 @@ pub fn eos(options: &EosOptions, out: &Path, jobs: usize) -> anyhow::Result<()> 
     spec.check()
         .map_err(|e| anyhow::anyhow!("the options as a sweep: {e}"))?;
     let tasks = out.join("eos-tasks");
+    // A finished run's tasks are measured again (the code or the machine may have changed);
+    // an unfinished one's go on.
+    if sweep::finished(&tasks) {
+        std::fs::remove_dir_all(&tasks)
+            .with_context(|| format!("removing the finished run's {}", tasks.display()))?;
+    }
     sweep::plan_spec(&spec, "these `eos` options", &tasks)?;
     sweep::run(&tasks, jobs)?;
     let points = sweep::eos_points(&tasks)?;

@@ -41,7 +41,7 @@ fn a_small_box_gives_liu_s_pressure_and_rayleigh_speeds() {
 }
 
 #[test]
-fn the_command_measures_each_point_as_a_task_and_does_not_measure_it_again() {
+fn the_command_measures_each_point_as_a_task_and_goes_on_from_where_it_stopped() {
     let out = std::env::temp_dir().join(format!("mc-eos-tasks-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let run = |fractions: &str| {
@@ -76,22 +76,43 @@ fn the_command_measures_each_point_as_a_task_and_does_not_measure_it_again() {
         let z: f64 = line.split(',').nth(z_column).unwrap().parse().unwrap();
         assert_eq!(z, measure(&options, phi).unwrap().z, "at {phi}");
     }
-    // Again with the same options: both points are done, none is measured again.
+    // Stopped with one point left (its result gone), run again: only that point is measured.
+    let result = out.join("eos-tasks/results/1.json");
+    std::fs::remove_file(&result).unwrap();
     let again = run("0.2,0.5");
     let said = String::from_utf8_lossy(&again.stdout);
     assert!(
-        again.status.success() && said.contains("0 of 0 tasks done here (2 done before)"),
+        again.status.success() && said.contains("1 of 1 tasks done here (1 done before)"),
         "{said}"
     );
-    assert_eq!(std::fs::read_to_string(out.join("eos.csv")).unwrap(), csv);
-    // Other options would mix two measurements in one folder: refused, nothing overwritten.
+    let z_of = |csv: &str| -> Vec<String> {
+        csv.lines()
+            .map(|l| l.split(',').nth(z_column).unwrap().to_owned())
+            .collect()
+    };
+    let csv_again = std::fs::read_to_string(out.join("eos.csv")).unwrap();
+    assert_eq!(z_of(&csv_again), z_of(&csv));
+    // Other options into an unfinished run would mix two measurements: refused, nothing
+    // overwritten.
+    std::fs::remove_file(&result).unwrap();
     let other = run("0.2,0.6");
     let stderr = String::from_utf8_lossy(&other.stderr);
     assert!(
         !other.status.success() && stderr.contains("holds another sweep's plan"),
         "{stderr}"
     );
-    assert_eq!(std::fs::read_to_string(out.join("eos.csv")).unwrap(), csv);
+    assert_eq!(
+        std::fs::read_to_string(out.join("eos.csv")).unwrap(),
+        csv_again
+    );
+    // A finished run is measured again whole.
+    assert!(run("0.2,0.5").status.success());
+    let fresh = run("0.2,0.5");
+    let said = String::from_utf8_lossy(&fresh.stdout);
+    assert!(
+        said.contains("2 of 2 tasks done here (0 done before)"),
+        "{said}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }
 

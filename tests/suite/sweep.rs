@@ -651,6 +651,19 @@ fn hostile_specs_are_refused_naming_the_field() {
         ),
         (
             format!(
+                r#"(scene: "{scene}", length: seconds(1.0), measure: trace(horizon: 0.1),
+                    axes: [solver(["discrete", "soft"])])"#
+            ),
+            "axes: the `trace` measure compares each setting with `exact`",
+        ),
+        (
+            format!(
+                r#"(scene: "{scene}", length: seconds(1.0), measure: pile, boundary: periodic)"#
+            ),
+            "boundary: goes with a particle file",
+        ),
+        (
+            format!(
                 r#"(scene: "{scene}", length: seconds(1.0), measure: pile, axes: [seed([1, 2])])"#
             ),
             "axes[0]: the `pile` measure varies `solver` and `dt` alone, not `seed`",

@@ -21,12 +21,13 @@ pub enum TaskMeasure {
     /// no length; the result is an `eos.csv` row. A task stopped before it ends starts again.
     Eos(EosMeasure),
     /// A run of the accuracy study under the task's solver and step: its report, and beside it
-    /// (`results/I.trace`) its circles at `horizon` seconds and at the end and the pairs that
+    /// (`results/I.trace`) its circles at `horizon` seconds and at the end and how many pairs
     /// passed through each other, which `merge` compares with the `exact` task at 60 Hz
     /// (`accuracy.csv`, and the study's five measures in the `accuracy` figure). The spec
     /// varies `solver` and `dt` alone and runs for `seconds(T)`.
     Trace {
-        /// When positions are compared, in simulated seconds (the study's 0.1).
+        /// When positions are compared, in simulated seconds (the study's 0.1; 0.3 for the
+        /// billiards break).
         horizon: f64,
     },
     /// A pile run of the accuracy study under the task's solver and step: overlap at rest,

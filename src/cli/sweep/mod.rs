@@ -374,6 +374,15 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
     crate::cli::run::run(options)
 }
 
+/// Whether `dir` holds a planned sweep whose every task is done.
+pub(crate) fn finished(dir: &Path) -> bool {
+    Plan::open(dir).is_ok_and(|plan| {
+        plan.tasks
+            .iter()
+            .all(|task| plan.folder.result(task.index).exists())
+    })
+}
+
 /// The points of the `eos` sweep in `dir`, in task order; every task must be done.
 pub(crate) fn eos_points(dir: &Path) -> anyhow::Result<Vec<crate::tools::eos::EosPoint>> {
     let plan = Plan::open(dir)?;

@@ -34,9 +34,6 @@ impl SweepSpec {
                 "only the `report` measure's tasks are runs that end in a state to keep",
             ));
         }
-        if matches!(self.measure, TaskMeasure::Trace { .. } | TaskMeasure::Pile) {
-            return self.check_study_measure();
-        }
         if self.boundary.is_some() && self.particles.is_none() {
             return Err(FieldError::new(
                 "boundary",
@@ -48,6 +45,9 @@ impl SweepSpec {
                 "particles",
                 "only the `report` measure runs a particle file; the others need a scene",
             ));
+        }
+        if matches!(self.measure, TaskMeasure::Trace { .. } | TaskMeasure::Pile) {
+            return self.check_study_measure();
         }
         let TaskMeasure::Eos(eos) = &self.measure else {
             match (&self.scene, &self.particles) {
@@ -158,6 +158,10 @@ impl SweepSpec {
                 ),
             ));
         }
+        // Each trace is compared with `exact` at 60 Hz: the spec must run it.
+        if name == "trace" {
+            self.check_reference("axes", "the `trace` measure")?;
+        }
         Ok(())
     }
 
@@ -212,12 +216,14 @@ impl SweepSpec {
     /// needs it to be 1/60 s.
     pub(super) fn check_scene_step(&self, dt: f64) -> Result<(), FieldError> {
         let dt_axis = self.axes.iter().any(|a| matches!(a, Axis::Dt(_)));
-        if self.figure == Some(SweepFigure::Accuracy) && !dt_axis && !is_reference_dt(dt) {
+        let compares = self.figure == Some(SweepFigure::Accuracy)
+            || matches!(self.measure, TaskMeasure::Trace { .. });
+        if compares && !dt_axis && !is_reference_dt(dt) {
             return Err(FieldError::new(
-                "figure",
+                "dt",
                 format!(
-                    "`accuracy` compares each setting with `exact` at 60 Hz, and the scene's \
-                     step is {dt} s: add a `dt` axis with 0.016666666666666666 (1/60)"
+                    "each setting is compared with `exact` at 60 Hz, and the scene's step is \
+                     {dt} s: add a `dt` axis with 0.016666666666666666 (1/60)"
                 ),
             ));
         }
@@ -227,6 +233,22 @@ impl SweepSpec {
     /// The `accuracy` figure compares each setting with `exact` at 60 Hz: the solvers include
     /// `exact`, and a `dt` axis (else the scene's step) includes 1/60 s.
     pub(super) fn check_accuracy_figure(&self) -> Result<(), FieldError> {
+        self.check_reference("figure", "`accuracy`")?;
+        let steps_axis = self.axes.iter().any(|a| matches!(a, Axis::Steps(_)));
+        if steps_axis || matches!(self.length, Some(SpecLength::Steps(_))) {
+            return Err(FieldError::new(
+                "figure",
+                "`accuracy` compares runs over the same simulated time: give `length: \
+                 seconds(T)` and no `steps` axis (steps of different sizes cover different times)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// What compares each setting with `exact` at 60 Hz (`what`, set by `field`) needs that
+    /// task: a `solver` axis with `exact`, combined by `product`, and a `dt` axis, if any, with
+    /// 1/60 (else the scene's step: [`SweepSpec::check_scene_step`]).
+    fn check_reference(&self, field: &str, what: &str) -> Result<(), FieldError> {
         let exact = Solver::REFERENCE.to_string();
         let has_reference = self.axes.iter().any(|a| match a {
             Axis::Solver(names) => names.iter().any(|n| n.parse() == Ok(Solver::REFERENCE)),
@@ -234,19 +256,11 @@ impl SweepSpec {
         });
         if !has_reference || self.combine == Combine::Zip {
             return Err(FieldError::new(
-                "figure",
+                field,
                 format!(
-                    "`accuracy` compares each setting with `{exact}`: the spec needs a `solver` \
+                    "{what} compares each setting with `{exact}`: the spec needs a `solver` \
                      axis that includes \"{exact}\", combined by `product`"
                 ),
-            ));
-        }
-        let steps_axis = self.axes.iter().any(|a| matches!(a, Axis::Steps(_)));
-        if steps_axis || matches!(self.length, Some(SpecLength::Steps(_))) {
-            return Err(FieldError::new(
-                "figure",
-                "`accuracy` compares runs over the same simulated time: give `length: \
-                 seconds(T)` and no `steps` axis (steps of different sizes cover different times)",
             ));
         }
         let dts = self.axes.iter().find_map(|a| match a {
@@ -257,9 +271,9 @@ impl SweepSpec {
             && !dts.iter().any(|&dt| is_reference_dt(dt))
         {
             return Err(FieldError::new(
-                "figure",
+                field,
                 format!(
-                    "`accuracy` compares each setting with `{exact}` at 60 Hz: the `dt` axis \
+                    "{what} compares each setting with `{exact}` at 60 Hz: the `dt` axis \
                      needs 0.016666666666666666 (1/60) among its values"
                 ),
             ));

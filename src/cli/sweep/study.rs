@@ -94,7 +94,14 @@ pub(crate) fn trace_rows(dir: &Path) -> anyhow::Result<Vec<Row>> {
             .take(MAX_TRACE_BYTES)
             .read_to_end(&mut bytes)
             .with_context(|| format!("{}", path.display()))?;
-        postcard::from_bytes(&bytes).with_context(|| format!("{}: not a trace", path.display()))
+        postcard::from_bytes(&bytes).with_context(|| {
+            format!(
+                "{}: not a trace this version reads (one from another build?): remove {} and \
+                 run the sweep again",
+                path.display(),
+                dir.display()
+            )
+        })
     };
     // The reference first; then one trace at a time, so that a big scene's traces are never
     // all in memory at once.

@@ -47,16 +47,22 @@ pub struct PileRow {
     /// Solver.
     pub solver: String,
     /// Step in seconds.
+    #[serde(deserialize_with = "number_or_nan")]
     pub dt: f64,
     /// Stepping cost per step.
+    #[serde(deserialize_with = "number_or_nan")]
     pub ms_per_step: f64,
     /// Stepping cost per simulated second.
+    #[serde(deserialize_with = "number_or_nan")]
     pub ms_per_sim_second: f64,
     /// Deepest overlap after any step, in smaller radii.
+    #[serde(deserialize_with = "number_or_nan")]
     pub max_penetration: f64,
     /// Deepest overlap in the final state, in smaller radii.
+    #[serde(deserialize_with = "number_or_nan")]
     pub rest_penetration: f64,
     /// Kinetic energy at the end over `N·m·g·r`.
+    #[serde(deserialize_with = "number_or_nan")]
     pub energy_left: f64,
     /// Simulated seconds after which the kinetic energy stayed below [`SETTLED`] `·N·m·g·r`.
     pub settled_at: Option<f64>,
@@ -66,6 +72,11 @@ pub struct PileRow {
     pub escaped: usize,
     /// Steps whose event budget ran out.
     pub budget_exhausted: u64,
+}
+
+/// A number as serde_json wrote it, where one that is not finite became `null`.
+fn number_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// Runs the pile `case` (a scene with gravity) under `solver` at step `dt` and measures it.
@@ -194,4 +205,32 @@ pub fn pile_table(rows: &[PileRow]) -> String {
         out.push_str(&format!("{scene:<9} {budget:>7.0e}  {what}\n"));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_row_with_a_number_that_is_not_finite_reads_back_from_json() {
+        let row = PileRow {
+            scene: "pile".into(),
+            n: 3,
+            solver: "soft".into(),
+            dt: 0.5,
+            ms_per_step: 1.0,
+            ms_per_sim_second: 2.0,
+            max_penetration: f64::NAN,
+            rest_penetration: f64::INFINITY,
+            energy_left: 0.25,
+            settled_at: None,
+            asleep: 0,
+            escaped: 0,
+            budget_exhausted: 0,
+        };
+        // serde_json writes NaN and infinity as `null`.
+        let back: PileRow = serde_json::from_str(&serde_json::to_string(&row).unwrap()).unwrap();
+        assert!(back.max_penetration.is_nan() && back.rest_penetration.is_nan());
+        assert_eq!(back.energy_left, 0.25);
+    }
 }
