@@ -11,7 +11,7 @@ use crate::tools::accuracy::front::MEASURES;
 use crate::tools::accuracy::piles::pile_table;
 use crate::tools::accuracy::plot::AccuracyFigure;
 use crate::tools::accuracy::report::to_fronts;
-use crate::tools::io::{csv_text, read_limited, say, write_atomically};
+use crate::tools::io::{csv_text, say, write_atomically};
 
 /// `sweep merge`: every task's settings and report as one row, into `merged.csv` and
 /// `merged.json` in the sweep's folder; every task must be done.
@@ -38,13 +38,7 @@ pub fn merge(dir: &Path) -> anyhow::Result<()> {
     }
     let mut rows = Vec::new();
     for task in &plan.tasks {
-        let path = folder.result(task.index);
-        let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
-        let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
-        let report: serde_json::Value = serde_json::from_str(&text)
-            .ok()
-            .filter(serde_json::Value::is_object)
-            .with_context(|| format!("{}: not a run report", path.display()))?;
+        let report = plan.result(task.index)?;
         rows.push(serde_json::json!({ "task": task, "report": report }));
     }
     let json = serde_json::to_string_pretty(&rows)?;

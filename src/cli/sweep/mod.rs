@@ -114,6 +114,17 @@ impl Plan {
             tasks,
         })
     }
+
+    /// Task `index`'s result: a JSON object (a report, a point, a row).
+    fn result(&self, index: usize) -> anyhow::Result<serde_json::Value> {
+        let path = self.folder.result(index);
+        let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
+        let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
+        serde_json::from_str(&text)
+            .ok()
+            .filter(serde_json::Value::is_object)
+            .with_context(|| format!("{}: not a task's result", path.display()))
+    }
 }
 
 /// `sweep plan`: checks the spec and its scene, and writes the plan into `out`.
@@ -389,12 +400,8 @@ pub(crate) fn eos_points(dir: &Path) -> anyhow::Result<Vec<crate::tools::eos::Eo
     plan.tasks
         .iter()
         .map(|task| {
-            let path = plan.folder.result(task.index);
-            let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
-            let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
-            let json =
-                serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
-            figures::eos_point(&json).with_context(|| format!("{}", path.display()))
+            figures::eos_point(&plan.result(task.index)?)
+                .with_context(|| format!("{}", plan.folder.result(task.index).display()))
         })
         .collect()
 }

@@ -15,7 +15,7 @@ use crate::base::config::Solver;
 use crate::cli::run::Finished;
 use crate::tools::accuracy::piles::{PileRow, measure_pile};
 use crate::tools::accuracy::{Case, Row, Trace, compare, trace};
-use crate::tools::io::{read_limited, write_atomically};
+use crate::tools::io::write_atomically;
 use crate::tools::scene::Scene;
 
 /// The largest trace read back: two states of a million circles are about 140 MB.
@@ -138,11 +138,12 @@ pub(crate) fn pile_rows(dir: &Path) -> anyhow::Result<Vec<PileRow>> {
     plan.tasks
         .iter()
         .map(|task| {
-            let path = plan.folder.result(task.index);
-            let file = std::fs::File::open(&path).with_context(|| format!("{}", path.display()))?;
-            let text = read_limited(file, 1 << 20).map_err(anyhow::Error::msg)?;
-            serde_json::from_str(&text)
-                .with_context(|| format!("{}: not a pile row", path.display()))
+            serde_json::from_value(plan.result(task.index)?).with_context(|| {
+                format!(
+                    "{}: not a pile row",
+                    plan.folder.result(task.index).display()
+                )
+            })
         })
         .collect()
 }
