@@ -1,8 +1,9 @@
 //! The structure rules of `src/`, checked on the source text: every import points down the
 //! layers (`base`, `collision`, `step`, `solvers`, `game`, `tools`, `render`, `cli`, and
 //! `lib.rs`, which declares them) or stays within its layer, no solver's folder imports
-//! another's, no two files or folders import each other through any chain, and no file is over
-//! 450 lines.
+//! another's, no two files or folders import each other through any chain, no file is over
+//! 450 lines, and only the config, the solvers' folders and the crate docs name a solver's
+//! variant.
 //!
 //! An import is any `crate::…` or `super::…` path in code (comments are skipped), including
 //! each branch of a `use` tree; it points at the deepest module file the path names.
@@ -422,4 +423,42 @@ fn no_source_file_is_over_450_lines() {
         })
         .collect();
     assert!(long.is_empty(), "split along their seams: {long:?}");
+}
+
+/// The files under `src/` that name a variant of `Solver` (in code, docs or tests), relative
+/// to `src/`.
+fn files_naming_solver_variants() -> BTreeSet<String> {
+    let variant = ["Discrete", "Substeps", "Swept", "Exact", "Soft"];
+    rust_files(&src())
+        .into_iter()
+        .filter(|f| {
+            let text = std::fs::read_to_string(f).unwrap();
+            text.match_indices("Solver::").any(|(at, _)| {
+                let rest = &text[at + "Solver::".len()..];
+                let name: String = rest
+                    .chars()
+                    .take_while(char::is_ascii_alphanumeric)
+                    .collect();
+                variant.contains(&name.as_str())
+            })
+        })
+        .map(|f| f.strip_prefix(src()).unwrap().display().to_string())
+        .collect()
+}
+
+#[test]
+fn solver_variants_are_named_only_by_the_config_the_solvers_and_the_crate_docs() {
+    // Adding a solver is its variant in the config, its folder and a line in the plugin group:
+    // whatever else must tell solvers apart asks `Solver`'s methods and lists.
+    let named = files_naming_solver_variants();
+    let elsewhere: Vec<&String> = named
+        .iter()
+        .filter(|f| !f.starts_with("solvers/") && *f != "base/config/mod.rs" && *f != "lib.rs")
+        .collect();
+    assert!(
+        elsewhere.is_empty(),
+        "ask Solver's methods or lists instead: {elsewhere:?}"
+    );
+    assert!(named.len() <= 6, "{named:?}");
+    assert!(named.contains("base/config/mod.rs"), "{named:?}");
 }

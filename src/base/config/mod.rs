@@ -125,6 +125,32 @@ impl Solver {
         Solver::Exact,
         Solver::Soft(SOFT_SUBSTEPS),
     ];
+
+    /// The settings the accuracy study compares on its gases, cheapest first by design (the
+    /// measurement decides); the last, `exact`, is the reference.
+    pub const STUDY: [Solver; 9] = [
+        Solver::Discrete,
+        Solver::Substeps(2),
+        Solver::Substeps(4),
+        Solver::Substeps(8),
+        Solver::Substeps(16),
+        Solver::Soft(4),
+        Solver::Soft(8),
+        Solver::Swept,
+        Solver::Exact,
+    ];
+
+    /// The settings the accuracy study runs its piles under: the course's, the contact solver
+    /// at two substep counts and the event-driven ones.
+    pub const PILE_STUDY: [Solver; 7] = [
+        Solver::Discrete,
+        Solver::Substeps(4),
+        Solver::Substeps(16),
+        Solver::Soft(4),
+        Solver::Soft(8),
+        Solver::Swept,
+        Solver::Exact,
+    ];
 }
 
 impl fmt::Display for Solver {

@@ -21,17 +21,9 @@ use crate::tools::run::{headless_app, run_steps};
 /// Kinetic energy (over `N·m·g·r`) below which a pile counts as settled.
 pub const SETTLED: f64 = 1e-4;
 
-/// The solvers the pile study runs: the course's, the contact solver at two substep counts and
-/// the event-driven ones.
-pub const PILE_SOLVERS: [Solver; 7] = [
-    Solver::Discrete,
-    Solver::Substeps(4),
-    Solver::Substeps(16),
-    Solver::Soft(4),
-    Solver::Soft(8),
-    Solver::Swept,
-    Solver::Exact,
-];
+/// The solvers the pile study runs ([`Solver::PILE_STUDY`]): the course's, the contact solver
+/// at two substep counts and the event-driven ones.
+pub const PILE_SOLVERS: [Solver; 7] = Solver::PILE_STUDY;
 
 /// Overlap budgets at rest (smaller radii) the picks are read for: a tenth, Box2D's slop at
 /// r = 0.5 (a fiftieth), and rounding.

@@ -19,7 +19,7 @@ fn taken(app: &mut App) -> Checkpoint {
 fn every_byte_changed_cut_or_added_is_refused_as_damaged() {
     let mut config = CirclesConfig::default();
     config.spawn.count = 8;
-    config.solver = Solver::Exact;
+    config.solver = "exact".parse().unwrap();
     let mut app = headless_app(config);
     app.update();
     let good = taken(&mut app).to_bytes();
@@ -75,7 +75,7 @@ fn every_byte_changed_cut_or_added_is_refused_as_damaged() {
 fn a_checkpoint_whose_arena_no_longer_holds_its_circles_is_refused() {
     let mut config = CirclesConfig::default();
     config.spawn.count = 16;
-    config.solver = Solver::Exact;
+    config.solver = "exact".parse().unwrap();
     let mut app = headless_app(config);
     app.update();
     let good = taken(&mut app);
@@ -124,7 +124,7 @@ fn a_checkpoint_whose_arena_no_longer_holds_its_circles_is_refused() {
 #[test]
 fn a_clock_that_is_not_its_steps_is_refused() {
     let mut app = headless_app(CirclesConfig {
-        solver: Solver::Swept,
+        solver: "swept".parse().unwrap(),
         ..default()
     });
     for _ in 0..40 {

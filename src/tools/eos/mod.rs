@@ -173,7 +173,8 @@ pub fn config(n: usize, phi: f64, seed: u64) -> CirclesConfig {
             placement: Placement::Lattice,
             ..SpawnConfig::default()
         },
-        solver: Solver::Exact,
+        // `exact`: hard disks event by event, the pressure from their collisions.
+        solver: Solver::REFERENCE,
         effects: Effects::default(),
         dt: step(phi),
         ..CirclesConfig::default()
