@@ -10,11 +10,11 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use moving_circles::base::circle::{CircleState, discs};
-use moving_circles::collision::broad_phase::{CellList, overlapping_pairs};
 use moving_circles::game::spawn::place_circles;
+use moving_circles::kernels::EventEngine;
+use moving_circles::kernels::{CellList, overlapping_pairs};
+use moving_circles::kernels::{ContactScratch, resolve_all_contacts};
 use moving_circles::prelude::*;
-use moving_circles::solvers::discrete::pass::{ContactScratch, resolve_all_contacts};
-use moving_circles::solvers::exact::engine::EventEngine;
 
 fn sizes() -> Vec<usize> {
     let mut n = vec![1_000, 10_000, 100_000];

@@ -92,7 +92,7 @@
 //! | `discrete` | moves, pushes overlapping pairs apart and applies the elastic impulse ([`solvers::discrete`]): the cheapest, but circles overlap and fast pairs tunnel. |
 //! | `substeps=N` | runs `discrete` N times a step with dt/N: errors shrink roughly like 1/N while the cost grows like N. |
 //! | `swept` | processes each step's pair and wall hits in time order at their times of impact ([`solvers::exact`]), afresh every step: no tunnelling, no overlap. |
-//! | `exact` | keeps one event-driven engine ([`solvers::exact::engine`]) across steps: the reference, exact to rounding, paying per collision rather than per step. |
+//! | `exact` | keeps one event-driven engine (`solvers::exact`'s engine, [`kernels::EventEngine`]) across steps: the reference, exact to rounding, paying per collision rather than per step. |
 //! | `soft` | the contact solver for games and piles ([`solvers::soft`]): persistent speculative contacts made soft springs, warm started and solved in 4 substeps (`soft=N`: N) with relaxation and a restitution pass, so stacks and piles rest. |
 //!
 //! # Modules
@@ -102,8 +102,8 @@
 //! - [`base`]: what every layer shares: the arena, a circle's state and its components, segment
 //!   walls, the configuration ([`CirclesConfig`](base::config::CirclesConfig)) with the limits on every value, hit messages
 //!   and counters, errors;
-//! - [`collision`]: the collision layer, free of the ECS: times of impact, roots, impulses
-//!   smooth and rough, the broad phase, pair lists, overlap measures;
+//! - `collision` (internal): the collision layer, free of the ECS: times of impact, roots,
+//!   impulses smooth and rough, the broad phase, pair lists, overlap measures;
 //! - [`step`]: what every solver's step shares: the [`CircleSystems`] sets and step schedules,
 //!   the registry that keeps exactly the effects a scene calls for, gravity and drag, free
 //!   flight, walls, periodic edges and segment walls, sleeping;
@@ -117,6 +117,10 @@
 //!   equation of state, files in and out;
 //! - [`render`] (feature `render`): the window, sprites, HUD, keys and the live panel;
 //! - [`cli`] (feature `cli`): the work behind each `moving_circles` command.
+//!
+//! [`kernels`] opens the plain-data kernels under the solvers to benchmarks, fuzz targets and
+//! tests outside the crate; the rest of the collision layer and the solvers' insides are the
+//! crate's own.
 //!
 //! # The guide
 //!
@@ -144,7 +148,7 @@ struct RollbackDoctests;
 pub mod base;
 #[cfg(feature = "cli")]
 pub mod cli;
-pub mod collision;
+mod collision;
 pub mod game;
 #[cfg(feature = "render")]
 pub mod render;
@@ -154,6 +158,26 @@ pub mod step;
 pub mod tools;
 
 pub use game::plugins::CirclesPlugins;
+
+/// The plain-data kernels under the solvers, public for what measures or attacks them from
+/// outside the crate (the criterion benches, the fuzz targets, the system tests) and for a
+/// study of your own: the broad phase, the contact and rough impulses, times of impact (under
+/// gravity too), the overlap measures, the discrete contact pass and the event engine. They
+/// work on plain arrays, without an App. Their signatures follow the solvers' needs and change with them.
+pub mod kernels {
+    pub use crate::collision::broad_phase::{CellList, overlapping_pairs, visit_overlapping_pairs};
+    pub use crate::collision::contact::{
+        apply_impulse, combine_restitution, resolve_contact, work_by_immovable,
+    };
+    pub use crate::collision::fall::{exit_time, falling_pair_time};
+    pub use crate::collision::overlaps::{Overlaps, overlapping_circles};
+    pub use crate::collision::rough::{RoughSide, apply_rough_impulse};
+    pub use crate::collision::toi::{
+        growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact,
+    };
+    pub use crate::solvers::discrete::pass::{ContactScratch, resolve_all_contacts};
+    pub use crate::solvers::exact::engine::{EventEngine, Roughness};
+}
 
 /// The common imports: the plugin group and its parts, components, configuration, sets and
 /// what the simulation measures.

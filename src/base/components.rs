@@ -96,7 +96,7 @@ impl Mass {
 
 /// A circle's own coefficient of restitution, in `[0, 1]`; without it a circle takes the
 /// scene's (`effects.restitution` against circles, `effects.wall_restitution` against walls).
-/// Two values meet as their minimum ([`combine_restitution`](crate::collision::contact::combine_restitution)),
+/// Two values meet as their minimum ([`combine_restitution`](crate::kernels::combine_restitution)),
 /// against other circles and walls alike, under every solver.
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
 #[reflect(Component, Debug)]

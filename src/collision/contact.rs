@@ -27,7 +27,7 @@ pub struct ContactOutcome {
 /// never makes a pair bouncier than the scene asks. Walls combine with circles the same way.
 ///
 /// ```
-/// use moving_circles::collision::contact::combine_restitution;
+/// use moving_circles::kernels::combine_restitution;
 ///
 /// assert_eq!(combine_restitution(1.0, 0.3), 0.3);
 /// ```
@@ -56,7 +56,7 @@ pub fn contact_normal(d: DVec2, closing: DVec2) -> (DVec2, f64) {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::collision::contact::apply_impulse;
+/// use moving_circles::kernels::apply_impulse;
 ///
 /// let (mut va, mut vb) = (DVec2::new(1.0, 0.0), DVec2::new(-2.0, 0.0));
 /// let j = apply_impulse(DVec2::X, &mut va, &mut vb, 1.0, 1.0, 1.0);
@@ -89,7 +89,7 @@ pub fn apply_impulse(
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::collision::contact::work_by_immovable;
+/// use moving_circles::kernels::work_by_immovable;
 ///
 /// // A paddle (inverse mass 0) sends a resting unit mass off at 2: it gave it 2 J and 2 N·s.
 /// let (work, impulse) =
@@ -115,7 +115,7 @@ pub fn work_by_immovable(
 }
 
 /// Resolves one pair in place if it overlaps: separates it along the normal (split by inverse
-/// mass) and applies [`apply_impulse`] when the pair approaches. `b` must be the image nearest
+/// mass) and applies `apply_impulse` when the pair approaches. `b` must be the image nearest
 /// to `a` on a periodic arena.
 ///
 /// Separation moves positions only, so with `restitution = 1` neither kinetic energy nor

@@ -16,7 +16,7 @@ use crate::base::segment::Segment;
 /// bounds) and for cell crossings (the cell's edges).
 ///
 /// ```
-/// use moving_circles::collision::fall::exit_time;
+/// use moving_circles::kernels::exit_time;
 ///
 /// // Dropped at rest from 0.5 under -4: it lands on 0 at τ = 0.5.
 /// let (t, high) = exit_time(0.5, 0.0, -4.0, 0.0, 1.0).unwrap();
@@ -70,7 +70,7 @@ pub fn exit_time(x: f64, v: f64, acc: f64, lo: f64, hi: f64) -> Option<(f64, boo
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::collision::fall::falling_pair_time;
+/// use moving_circles::kernels::falling_pair_time;
 ///
 /// // A ball 2 above a peg, radii summing to 1, dropped at rest under g = 2: it falls 1 in 1.
 /// let (dp, dv, da) = (DVec2::new(0.0, -2.0), DVec2::ZERO, DVec2::new(0.0, 2.0));

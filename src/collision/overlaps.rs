@@ -16,7 +16,7 @@ use crate::base::collision_layers::{CollisionLayers, pair_meets};
 /// ```
 /// use bevy::math::DVec2;
 /// use moving_circles::base::arena::Arena;
-/// use moving_circles::collision::overlaps::overlapping_circles;
+/// use moving_circles::kernels::overlapping_circles;
 ///
 /// let circles = [(DVec2::ZERO, 0.5), (DVec2::new(0.75, 0.0), 0.5)];
 /// assert_eq!(overlapping_circles(&circles, &Arena::default(), &[]), [(0, 1, 0.25)]);

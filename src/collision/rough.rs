@@ -44,7 +44,7 @@ impl RoughSide {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::collision::rough::{RoughSide, apply_rough_impulse};
+/// use moving_circles::kernels::{RoughSide, apply_rough_impulse};
 ///
 /// // A ball sliding right along a floor below it (n points down, into the floor), unit mass
 /// // and radius, uniform disc (inverse inertia 2): a perfectly rough floor reverses the slip.

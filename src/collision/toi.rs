@@ -44,7 +44,7 @@ pub fn pair_time_of_impact(dp: DVec2, dv: DVec2, sigma: f64) -> Option<f64> {
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::collision::toi::growing_pair_time_of_impact;
+/// use moving_circles::kernels::growing_pair_time_of_impact;
 ///
 /// // At rest, 3 apart, radii summing to 1 and growing at 0.5: they touch at τ = 4.
 /// let t = growing_pair_time_of_impact(DVec2::new(3.0, 0.0), DVec2::ZERO, 1.0, 0.5);
@@ -102,7 +102,7 @@ pub fn wall_time_of_impact(x: f64, v: f64, lo: f64, hi: f64, growth: f64) -> Opt
 ///
 /// ```
 /// use bevy::math::DVec2;
-/// use moving_circles::collision::toi::segment_time_of_impact;
+/// use moving_circles::kernels::segment_time_of_impact;
 /// use moving_circles::base::segment::Segment;
 ///
 /// let wall = Segment::new(DVec2::new(0.0, -1.0), DVec2::new(0.0, 1.0));

@@ -7,7 +7,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::base::circle::snapshot_with_entities;
-use moving_circles::collision::overlaps::overlapping_circles;
+use moving_circles::kernels::overlapping_circles;
 use moving_circles::prelude::*;
 use moving_circles::solvers::exact::EngineState;
 use rand::{Rng, SeedableRng};

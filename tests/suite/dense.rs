@@ -7,8 +7,8 @@ use std::process::Command;
 use crate::common::{area_fraction, create_app, dense_config, energy_momentum, scene_app, step};
 use bevy::math::DVec2;
 use moving_circles::base::circle::{discs, snapshot};
-use moving_circles::collision::overlaps::Overlaps;
 use moving_circles::game::spawn::place_circles;
+use moving_circles::kernels::Overlaps;
 use moving_circles::prelude::*;
 
 /// A unit box asked for `fraction` of circles of radius `r` on a lattice.

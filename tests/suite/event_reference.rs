@@ -8,7 +8,7 @@ use crate::common::unit_box_gas;
 use bevy::math::DVec2;
 use moving_circles::base::arena::{Arena, Boundary};
 use moving_circles::base::circle::CircleState;
-use moving_circles::solvers::exact::engine::EventEngine;
+use moving_circles::kernels::EventEngine;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

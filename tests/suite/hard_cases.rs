@@ -28,7 +28,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::base::circle::{CircleState, discs, snapshot};
-use moving_circles::collision::overlaps::overlapping_circles;
+use moving_circles::kernels::overlapping_circles;
 use moving_circles::prelude::*;
 use moving_circles::tools::run::run_steps;
 use moving_circles::tools::scene::particles;

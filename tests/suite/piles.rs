@@ -11,7 +11,7 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::base::circle::{CircleState, discs, snapshot};
-use moving_circles::collision::overlaps::Overlaps;
+use moving_circles::kernels::Overlaps;
 use moving_circles::prelude::*;
 
 fn scene(name: &str, solver: &str) -> App {

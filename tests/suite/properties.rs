@@ -6,10 +6,10 @@ use crate::common::unit_box_gas;
 use bevy::math::DVec2;
 use moving_circles::base::arena::Arena;
 use moving_circles::base::circle::{CircleState, disc_inverse_inertia};
-use moving_circles::collision::contact::resolve_contact;
-use moving_circles::collision::rough::{RoughSide, apply_rough_impulse};
-use moving_circles::collision::toi::pair_time_of_impact;
-use moving_circles::solvers::exact::engine::EventEngine;
+use moving_circles::kernels::EventEngine;
+use moving_circles::kernels::pair_time_of_impact;
+use moving_circles::kernels::resolve_contact;
+use moving_circles::kernels::{RoughSide, apply_rough_impulse};
 use moving_circles::step::boundary::reflect_off_walls;
 use proptest::prelude::*;
 

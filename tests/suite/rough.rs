@@ -11,9 +11,9 @@ use crate::common::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use moving_circles::base::circle::{CircleState, disc_inertia};
+use moving_circles::kernels::{EventEngine, Roughness};
 use moving_circles::prelude::*;
 use moving_circles::solvers::exact::EngineState;
-use moving_circles::solvers::exact::engine::{EventEngine, Roughness};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

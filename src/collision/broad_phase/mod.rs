@@ -16,7 +16,7 @@ use std::ops::ControlFlow;
 use bevy::math::DVec2;
 
 use crate::base::arena::Arena;
-pub use cells::{CellList, PARALLEL_FROM, radius_range};
+pub use cells::{CellList, radius_range};
 pub use scan::pairs_in_cell_order;
 
 /// Radius ratio (largest / smallest) above which [`overlapping_pairs`] sorts circles into
@@ -36,7 +36,7 @@ pub fn needs_levels((r_min, r_max): (f64, f64)) -> bool {
 /// ```
 /// use bevy::math::DVec2;
 /// use moving_circles::base::arena::Arena;
-/// use moving_circles::collision::broad_phase::{CellList, overlapping_pairs};
+/// use moving_circles::kernels::{CellList, overlapping_pairs};
 ///
 /// let circles = [(DVec2::ZERO, 0.5), (DVec2::new(0.9, 0.0), 0.5), (DVec2::new(3.0, 0.0), 0.5)];
 /// let mut pairs = Vec::new();
@@ -66,7 +66,7 @@ pub fn overlapping_pairs(
 /// use std::ops::ControlFlow;
 /// use bevy::math::DVec2;
 /// use moving_circles::base::arena::Arena;
-/// use moving_circles::collision::broad_phase::visit_overlapping_pairs;
+/// use moving_circles::kernels::visit_overlapping_pairs;
 ///
 /// // 1000 circles at one point overlap in 499 500 pairs; the visit stops after the first.
 /// let circles = vec![(DVec2::ZERO, 0.5); 1000];
@@ -93,6 +93,7 @@ pub fn visit_overlapping_pairs(
 
 #[cfg(test)]
 mod tests {
+    use super::cells::PARALLEL_FROM;
     use super::*;
     use crate::base::arena::Boundary;
     use rand::{Rng, SeedableRng};

@@ -1,6 +1,6 @@
 //! The index behind the spatial queries: the circles binned into cell lists by the broad
 //! phase's counting sort ([`CellList`]), one list per size level when radii span more than
-//! [`MULTI_LEVEL_RATIO`](crate::collision::broad_phase::MULTI_LEVEL_RATIO), each cell's circles
+//! `MULTI_LEVEL_RATIO`, each cell's circles
 //! stored side by side. A query near a point looks at the few cells around it; a ray walks
 //! the cells it crosses in order (a grid traversal), testing the circles of the cells within
 //! reach of each, and stops at the first cell past its nearest hit.

@@ -1,12 +1,12 @@
 //! The course's method, `discrete` and `substeps=N`: the step's forces, integration and walls
 //! (`crate::step`), then circle-circle collisions. [`DiscretePlugin`] registers the step:
 //! [`CircleStep`] run once per substep over `dt / substeps`. [`CollidePlugin`] schedules the collision
-//! system when the scene calls for collisions: it gathers the circles into the [`pass`]'s flat
+//! system when the scene calls for collisions: it gathers the circles into the `pass`'s flat
 //! arrays, which finds overlapping pairs with the broad phase and resolves each with the
 //! contact kernel (both in `crate::collision`), and scatters the result back. On a periodic
 //! arena pairs interact across the seam through the minimum image.
 
-pub mod pass;
+pub(crate) mod pass;
 
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;

@@ -54,7 +54,7 @@ impl ContactScratch {
     }
 
     /// Gives the circle pushed last its own restitution. Either every circle gets one (pushed
-    /// right after it) or none does; a pair then bounces with [`combine_restitution`] of theirs.
+    /// right after it) or none does; a pair then bounces with `combine_restitution` of theirs.
     #[inline]
     pub fn push_restitution(&mut self, restitution: f64) {
         self.restitutions.push(restitution);
@@ -98,7 +98,7 @@ pub struct PassStats {
 /// out pairs whose layers do not meet. Each
 /// collision is recorded in `hits` if given (circle indices in push order, time 0).
 ///
-/// Circles of similar size are found in cell order ([`pairs_in_cell_order`]) and their centres
+/// Circles of similar size are found in cell order (`pairs_in_cell_order`) and their centres
 /// are corrected in that order, on nearby memory; radii spanning decades go through the
 /// multi-level broad phase in input order.
 pub fn resolve_all_contacts(

@@ -1,4 +1,4 @@
-//! The continuous solvers, `swept` and `exact`, built on one event-driven [`engine`]:
+//! The continuous solvers, `swept` and `exact`, built on one event-driven `engine`:
 //! - `exact` keeps one engine alive across steps (cost per collision, not per step) and only
 //!   rebuilds it when something outside changed the circles (a respawn, a drag with the mouse,
 //!   a force effect, a solver switch);
@@ -16,7 +16,7 @@
 //! write-back: a step where nothing outside touched the circles pays for its events, Bevy's
 //! change-tick check and one write per circle, not for comparing every circle's values.
 
-pub mod engine;
+pub(crate) mod engine;
 mod keep;
 mod outside;
 pub(crate) mod pack;

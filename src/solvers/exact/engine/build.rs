@@ -62,7 +62,7 @@ impl EventEngine {
     }
 
     /// [`EventEngine::new`] under `gravity`: movable circles fly parabolas, and each starts with
-    /// its [`Rest`] in `rest` (one per circle, or none: all awake, not at rest). A circle whose bounce on a support
+    /// its `Rest` in `rest` (one per circle, or none: all awake, not at rest). A circle whose bounce on a support
     /// (a wall, a segment wall, an immovable or sleeping circle) dies down falls asleep; a
     /// sleeping circle wakes when hit hard, or when [`EventEngine::set_motion`] moves it.
     pub fn falling(
@@ -88,7 +88,7 @@ impl EventEngine {
 
     /// [`EventEngine::new`], or [`EventEngine::falling`] under `gravity`, with each circle's
     /// `layers` (empty: every pair meets, [`EventEngine::set_layers`]), asking `stop` as its
-    /// tables fill and every [`STOP_POLL_CIRCLES`] predictions whether to give up: `None` when
+    /// tables fill and every `STOP_POLL_CIRCLES` predictions whether to give up: `None` when
     /// it did. A build of
     /// millions of circles takes seconds, which a signal must not wait for.
     pub fn build_until(

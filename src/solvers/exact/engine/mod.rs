@@ -63,7 +63,7 @@ pub const STOP_POLL_EVENTS: u64 = 4096;
 /// use bevy::math::DVec2;
 /// use moving_circles::base::arena::Arena;
 /// use moving_circles::base::circle::CircleState;
-/// use moving_circles::solvers::exact::engine::EventEngine;
+/// use moving_circles::kernels::EventEngine;
 ///
 /// let circles = [
 ///     CircleState::new(DVec2::new(-2.0, 0.0), DVec2::new(1.0, 0.0), 0.5),
@@ -139,7 +139,7 @@ pub struct EventEngine {
 
 impl EventEngine {
     /// Gives each circle its own restitution (one value per circle, in order; empty: all take
-    /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`](crate::collision::contact::combine_restitution).
+    /// the engine's). Pairs and wall hits then bounce with [`combine_restitution`](crate::kernels::combine_restitution).
     pub fn set_own_restitutions(&mut self, restitutions: Vec<f64>) {
         assert!(restitutions.is_empty() || restitutions.len() == self.len());
         self.own_restitution = restitutions;
@@ -289,7 +289,7 @@ impl EventEngine {
         self.asleep[i]
     }
 
-    /// Circle `i`'s [`Rest`] now: what a fresh engine needs to go on resting it.
+    /// Circle `i`'s `Rest` now: what a fresh engine needs to go on resting it.
     pub fn rest(&self, i: usize) -> Rest {
         let (anchor, since) = self.anchor[i];
         Rest {
@@ -317,7 +317,7 @@ impl EventEngine {
     }
 
     /// [`EventEngine::advance_to`], also stopping early (as if the budget ran out) when `stop`
-    /// says so; it is asked every [`STOP_POLL_EVENTS`] events.
+    /// says so; it is asked every `STOP_POLL_EVENTS` events.
     pub fn advance_until_stopped(
         &mut self,
         t_end: f64,
