@@ -19,7 +19,7 @@ use crate::tools::accuracy::piles::PILE_SOLVERS;
 use crate::tools::accuracy::plot::AccuracyFigure;
 use crate::tools::accuracy::report::{to_fronts, to_table};
 use crate::tools::accuracy::{Case, SOLVERS, default_cases, pile_cases, steps};
-use crate::tools::io::{csv_text, say, write_atomically};
+use crate::tools::io::{say, write_csv};
 
 /// Runs the study on the scenes in `scenes` (one step size and shorter runs when `quick`),
 /// `jobs` runs at a time, and writes its CSVs and plot into `out`.
@@ -58,12 +58,7 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool, jobs: usize) -> anyhow::
     to_fronts(&rows, &MEASURES).lines().for_each(say);
     write_results(&rows, &AccuracyFigure::study(&rows), out, "accuracy")?;
     // (Each pile scene's merge printed its table and picks.)
-    let csv = out.join("piles.csv");
-    let text = csv_text(&piles).context("formatting the CSV")?;
-    write_atomically(&csv, text.as_bytes())
-        .with_context(|| format!("writing {}", csv.display()))?;
-    say(format_args!("wrote {}", csv.display()));
-    Ok(())
+    write_csv(&piles, &out.join("piles.csv"))
 }
 
 /// The study's sweeps, one a scene, each with its name: the gases under every solver with the

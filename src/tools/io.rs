@@ -309,6 +309,16 @@ pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String, csv::Error> {
     Ok(String::from_utf8(bytes).expect("csv writes the UTF-8 it is given"))
 }
 
+/// Writes `rows` as CSV to `path`, atomically, and says so.
+pub fn write_csv<T: serde::Serialize>(rows: &[T], path: &Path) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let text = csv_text(rows).context("formatting the CSV")?;
+    write_atomically(path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    say(format_args!("wrote {}", path.display()));
+    Ok(())
+}
+
 /// Writes a line to stdout. A closed pipe (`moving_circles run … | head -1`) ends the reader's
 /// interest, not the work: the files asked for are still written, so a failed write to stdout
 /// is ignored instead of panicking as `println!` does.

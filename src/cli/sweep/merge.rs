@@ -11,7 +11,7 @@ use crate::tools::accuracy::front::MEASURES;
 use crate::tools::accuracy::piles::pile_table;
 use crate::tools::accuracy::plot::AccuracyFigure;
 use crate::tools::accuracy::report::to_fronts;
-use crate::tools::io::{csv_text, say, write_atomically};
+use crate::tools::io::{say, write_atomically, write_csv};
 
 /// `sweep merge`: every task's settings and report as one row, into `merged.csv` and
 /// `merged.json` in the sweep's folder; every task must be done.
@@ -77,15 +77,6 @@ pub fn merge(dir: &Path) -> anyhow::Result<()> {
         Some(SweepFigure::Accuracy) => figures::accuracy(&rows, &plan.spec, dir)?,
         None => {}
     }
-    Ok(())
-}
-
-/// Writes `rows` as CSV at `path`, atomically, and says so.
-fn write_csv<T: serde::Serialize>(rows: &[T], path: &Path) -> anyhow::Result<()> {
-    let text = csv_text(rows).context("formatting the CSV")?;
-    write_atomically(path, text.as_bytes())
-        .with_context(|| format!("writing {}", path.display()))?;
-    say(format_args!("wrote {}", path.display()));
     Ok(())
 }
 

@@ -201,7 +201,8 @@ pub fn resolve_all_contacts(
 
 /// Pushes overlapping circles apart (positions only, split by inverse mass, kept inside the
 /// arena), for at most a bounded number of sweeps; whatever still overlaps is for the caller's
-/// overlap check to report.
+/// overlap check to report. (Scene files ask for it: feature `tools`.)
+#[cfg(feature = "tools")]
 pub fn separate_overlaps(circles: &mut [CircleState], arena: &Arena) {
     let mut scratch = ContactScratch::default();
     for _ in 0..1000 {
