@@ -148,3 +148,21 @@ fn the_sample_particle_files_load_exactly() {
     assert_eq!((brownian[0].radius, brownian[0].mass), (0.1, 1.0));
     assert_eq!(brownian[0].tint, [17, 247, 236]);
 }
+
+#[test]
+fn a_mass_inside_spawn_is_refused_not_overwritten_by_the_top_level_one() {
+    // The top-level `mass` gives spawned circles their masses; one inside `spawn` used to be
+    // read and then silently replaced by it.
+    let text = "(mass: Equal(2.0), spawn: (count: 3, mass: Equal(5.0)))";
+    let error = Scene::parse(text, "two_masses.ron")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("two_masses.ron"), "{error}");
+    assert!(error.contains("`mass`"), "{error}");
+    assert!(error.contains("top level"), "{error}");
+    let config = Scene::parse("(mass: Equal(2.0), spawn: (count: 3))", "s.ron")
+        .unwrap()
+        .to_config("s.ron")
+        .unwrap();
+    assert_eq!(config.spawn.mass, MassModel::Equal(2.0));
+}

@@ -88,7 +88,10 @@ pub struct SpawnConfig {
     pub speed: (f64, f64),
     /// Seed of the random generator: the same seed gives the same circles.
     pub seed: u64,
-    /// How masses are assigned.
+    /// How masses are assigned. Not read from a scene, whose top-level `mass` gives the masses
+    /// of spawned and placed circles alike: a `mass` inside a scene's `spawn` is refused, not
+    /// overwritten.
+    #[serde(skip)]
     pub mass: MassModel,
     /// Placement attempts per circle before it is given up as not fitting.
     pub attempts_per_circle: u32,
