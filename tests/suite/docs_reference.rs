@@ -1,8 +1,11 @@
 //! The guide's reference tables against the code they describe: the configuration reference
 //! in `docs/cli.md` against the scene schema (every field a scene takes is documented, every
-//! documented field is one a scene takes).
+//! documented field is one a scene takes), and `docs/cli-reference.md` against the command
+//! line's own help (it is that help; `MC_BLESS=1` writes it anew), with every `moving_circles`
+//! command line in the guide using only flags its command takes.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::process::Command;
 
 use bevy::math::DVec2;
 use moving_circles::base::config::{DropConfig, SpawnConfig};
@@ -176,4 +179,130 @@ fn every_field_the_configuration_reference_names_is_taken_by_a_scene() {
             panic!("a scene giving only the documented `{field}` is refused: {e} ({scene})");
         }
     }
+}
+
+/// The commands whose help the command-line reference holds, as typed after `moving_circles`.
+const COMMANDS: [&str; 11] = [
+    "",
+    "run",
+    "systems",
+    "accuracy",
+    "eos",
+    "sweep",
+    "sweep plan",
+    "sweep task",
+    "sweep run",
+    "sweep status",
+    "sweep merge",
+];
+
+/// `moving_circles COMMAND --help`.
+fn help_of(command: &str) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_moving_circles"))
+        .args(command.split_whitespace())
+        .arg("--help")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{command} --help failed");
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// The command-line reference as the parser's help makes it.
+fn cli_reference() -> String {
+    let mut page = String::from(
+        "# Command-line reference\n\n\
+         Every command's `--help`, as the parser prints it; `tests/suite/docs_reference.rs` \
+         fails when\nthis page and the parser differ, and `MC_BLESS=1 cargo test --all-features \
+         --test suite\ncli_reference` writes it anew. How the commands are used: [cli.md](cli.md) \
+         and\n[sweeps.md](sweeps.md).\n",
+    );
+    for command in COMMANDS {
+        let name = format!("moving_circles {command}");
+        page.push_str(&format!(
+            "\n## `{}`\n\n```text\n{}```\n",
+            name.trim_end(),
+            help_of(command)
+        ));
+    }
+    page
+}
+
+#[test]
+fn the_cli_reference_is_the_parsers_help() {
+    let path = "docs/cli-reference.md";
+    let made = cli_reference();
+    if std::env::var_os("MC_BLESS").is_some() {
+        std::fs::write(path, &made).unwrap();
+    }
+    let kept = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(
+        kept == made,
+        "{path} is not the parser's help: run `MC_BLESS=1 cargo test --all-features --test suite \
+         cli_reference` and read the diff"
+    );
+}
+
+/// The long flags a help text names.
+fn flags_in(text: &str) -> BTreeSet<String> {
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+        .filter(|w| w.starts_with("--") && w.len() > 2)
+        .map(str::to_owned)
+        .collect()
+}
+
+#[test]
+fn every_command_line_in_the_guide_uses_flags_its_command_takes() {
+    let flags: BTreeMap<&str, BTreeSet<String>> = COMMANDS
+        .iter()
+        .map(|&c| (c, flags_in(&help_of(c))))
+        .collect();
+    let mut pages = vec![std::path::PathBuf::from("README.md")];
+    for entry in std::fs::read_dir("docs").unwrap() {
+        let path = entry.unwrap().path();
+        let history = path.file_name().is_some_and(|n| n == "history.md");
+        if path.extension().is_some_and(|e| e == "md") && !history {
+            pages.push(path);
+        }
+    }
+    let mut wrong = Vec::new();
+    let mut checked = 0;
+    for page in &pages {
+        let text = std::fs::read_to_string(page).unwrap();
+        for (n, line) in text.lines().enumerate() {
+            for (at, _) in line.match_indices("moving_circles ") {
+                // A path to the binary handed to another program is not a command line here.
+                if line[..at].ends_with('/') {
+                    continue;
+                }
+                // The command line runs to the end of the line or of its code span, comment
+                // or pipe.
+                let rest = &line[at + "moving_circles ".len()..];
+                let end = rest.find(['`', '#', '|', ';', ')']).unwrap_or(rest.len());
+                let words: Vec<&str> = rest[..end].split_whitespace().collect();
+                // The longest command the words start with (`sweep run` before `sweep`).
+                let command = COMMANDS
+                    .iter()
+                    .rev()
+                    .find(|c| {
+                        let names: Vec<&str> = c.split(' ').collect();
+                        words.starts_with(&names) || c.is_empty()
+                    })
+                    .copied()
+                    .unwrap_or("");
+                for flag in words.iter().filter(|w| w.starts_with("--")) {
+                    let flag = flag.split('=').next().unwrap();
+                    checked += 1;
+                    if !flags[command].contains(flag) {
+                        let at = format!("{}:{}", page.display(), n + 1);
+                        wrong.push(format!("{at}: `moving_circles {command}` takes no {flag}"));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        checked > 50,
+        "only {checked} flags found: is the guide read?"
+    );
+    assert!(wrong.is_empty(), "{wrong:#?}");
 }
