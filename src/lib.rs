@@ -126,10 +126,12 @@
 //!
 //! The repository's `README.md` is the front door; its `docs/` folder holds one page per
 //! concern, each figure with the command that made it: `docs/cli.md` (the app, headless runs,
-//! scenes, the configuration reference), `docs/solvers.md` (the accuracy study and what to
-//! pick), `docs/physics.md`, `docs/embedding.md`, `docs/robustness.md`, `docs/performance.md`,
-//! `docs/architecture.md`, `docs/testing.md` and `docs/history.md`; `benches/README.md`
-//! describes the benchmarks.
+//! scenes, the configuration reference), `docs/cli-reference.md` (every command's options),
+//! `docs/solvers.md` (the accuracy study and what to pick), `docs/piles.md` (piles and stacks
+//! under gravity), `docs/physics.md`, `docs/embedding.md`, `docs/rollback.md` (rollback
+//! netcode), `docs/sweeps.md` (grids of runs, on Slurm too), `docs/robustness.md`,
+//! `docs/performance.md`, `docs/architecture.md`, `docs/testing.md` and `docs/history.md`;
+//! `benches/README.md` describes the benchmarks.
 #![warn(missing_docs)]
 
 // The Rust examples of the README and of the guide's embedding and rollback pages, compiled

@@ -2,7 +2,8 @@
 //! in `docs/cli.md` against the scene schema (every field a scene takes is documented, every
 //! documented field is one a scene takes), and `docs/cli-reference.md` against the command
 //! line's own help (it is that help; `MC_BLESS=1` writes it anew), with every `moving_circles`
-//! command line in the guide using only flags its command takes.
+//! command line in the guide using only flags its command takes; and the crate's front page
+//! (`src/lib.rs`) naming every guide page and linking every public module.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::process::Command;
@@ -305,4 +306,37 @@ fn every_command_line_in_the_guide_uses_flags_its_command_takes() {
         "only {checked} flags found: is the guide read?"
     );
     assert!(wrong.is_empty(), "{wrong:#?}");
+}
+
+/// The crate documentation's front page: the `//!` lines of `src/lib.rs`.
+fn front_page() -> String {
+    let text = std::fs::read_to_string("src/lib.rs").unwrap();
+    let lines = text.lines().filter_map(|l| l.strip_prefix("//!"));
+    lines.collect::<Vec<_>>().join("\n")
+}
+
+#[test]
+fn the_crate_front_page_names_every_guide_page_and_links_every_public_module() {
+    let page = front_page();
+    let mut missing = Vec::new();
+    for entry in std::fs::read_dir("docs").unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if name.ends_with(".md") && name != "README.md" && !page.contains(&format!("`docs/{name}`"))
+        {
+            missing.push(format!("docs/{name}"));
+        }
+    }
+    let lib = std::fs::read_to_string("src/lib.rs").unwrap();
+    let modules = lib
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("pub mod "));
+    for module in modules.map(|m| m.trim_end_matches([';', ' ', '{'])) {
+        if !page.contains(&format!("[`{module}`]")) {
+            missing.push(format!("module {module}"));
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "src/lib.rs's front page lacks {missing:?}"
+    );
 }
