@@ -161,15 +161,14 @@ pub mod tools;
 
 pub use game::plugins::CirclesPlugins;
 
-/// The plain-data kernels under the solvers, public for what measures or attacks them from
-/// outside the crate (the criterion benches, the fuzz targets, the system tests) and for a
-/// study of your own: the broad phase, the contact and rough impulses, times of impact (under
+/// The plain-data kernels under the solvers, public for what measures them from outside the
+/// crate (the criterion benches, the system tests) and for a study of your own: the broad phase, the contact and rough impulses, times of impact (under
 /// gravity too), the overlap measures, the discrete contact pass and the event engine. They
 /// work on plain arrays, without an App. Their signatures follow the solvers' needs and change with them.
 pub mod kernels {
     pub use crate::collision::broad_phase::{CellList, overlapping_pairs, visit_overlapping_pairs};
     pub use crate::collision::contact::{
-        apply_impulse, combine_restitution, resolve_contact, work_by_immovable,
+        ContactOutcome, apply_impulse, combine_restitution, resolve_contact, work_by_immovable,
     };
     pub use crate::collision::fall::{exit_time, falling_pair_time};
     pub use crate::collision::overlaps::{Overlaps, overlapping_circles};
@@ -177,8 +176,10 @@ pub mod kernels {
     pub use crate::collision::toi::{
         growing_pair_time_of_impact, pair_time_of_impact, segment_time_of_impact,
     };
-    pub use crate::solvers::discrete::pass::{ContactScratch, resolve_all_contacts};
-    pub use crate::solvers::exact::engine::{EventEngine, Roughness};
+    pub use crate::solvers::discrete::pass::{ContactScratch, PassStats, resolve_all_contacts};
+    pub use crate::solvers::exact::engine::{
+        BudgetExhausted, EngineSnapshot, EventEngine, EventStats, Rest, Roughness,
+    };
 }
 
 /// The common imports: the plugin group and its parts, components, configuration, sets and

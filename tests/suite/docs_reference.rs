@@ -119,37 +119,29 @@ fn at<'a>(value: &'a Value, path: &str) -> Option<&'a Value> {
     })
 }
 
-/// A scene giving `path` alone, set to `value` (a list's field in a one-item list).
+/// A scene giving `path` alone, set to `value`.
 fn scene_with(full: &Value, path: &str, value: Value) -> Value {
     let (head, rest) = path.split_once('.').unwrap_or((path, ""));
-    if rest.is_empty() {
-        return Value::Object(Map::from_iter([(head.to_owned(), value)]));
-    }
-    let inner = &full[head];
-    match inner.as_array() {
-        Some(items) => {
-            // An item of a list needs its required fields: start from the full one.
-            let mut item = items[0].clone();
-            let (first, _) = rest.split_once('.').unwrap_or((rest, ""));
-            item[first] = scene_with(&items[0], rest, value)[first].clone();
-            Value::Object(Map::from_iter([(
-                head.to_owned(),
-                Value::Array(vec![item]),
-            )]))
-        }
-        None => Value::Object(Map::from_iter([(
-            head.to_owned(),
-            scene_with(inner, rest, value),
-        )])),
-    }
+    let inner = match rest {
+        "" => value,
+        _ => scene_with(&full[head], rest, value),
+    };
+    Value::Object(Map::from_iter([(head.to_owned(), inner)]))
 }
 
 #[test]
 fn every_field_a_scene_takes_is_in_the_configuration_reference() {
     let documented = documented_fields();
     let mut paths = BTreeSet::new();
-    field_paths(&full_scene(), "", &mut paths);
+    let full = full_scene();
+    field_paths(&full, "", &mut paths);
     assert!(paths.contains("effects.sleep.time"), "{paths:?}");
+    // An optional part left out would hide its fields: `full_scene` gives every one.
+    let absent: Vec<&String> = paths
+        .iter()
+        .filter(|p| at(&full, p) == Some(&Value::Null))
+        .collect();
+    assert!(absent.is_empty(), "give these in full_scene: {absent:?}");
     // A field is documented in a row of its own, or named in its parent's row (`circles`:
     // `position`, `radius`, ...).
     let missing: Vec<&String> = paths
@@ -243,12 +235,53 @@ fn the_cli_reference_is_the_parsers_help() {
     );
 }
 
-/// The long flags a help text names.
-fn flags_in(text: &str) -> BTreeSet<String> {
-    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+/// The long flags a help text's option lines give (not those its descriptions mention).
+fn flags_in(help: &str) -> BTreeSet<String> {
+    help.lines()
+        .map(str::trim_start)
+        .filter(|line| line.starts_with('-'))
+        .flat_map(|line| line.split("  ").next().unwrap_or("").split([' ', ',', '=']))
         .filter(|w| w.starts_with("--") && w.len() > 2)
         .map(str::to_owned)
         .collect()
+}
+
+/// The pages whose command lines are checked: the README, the guide but its history, the
+/// benchmarks' README.
+fn guide_pages() -> Vec<std::path::PathBuf> {
+    let mut pages = vec!["README.md".into(), "benches/README.md".into()];
+    for entry in std::fs::read_dir("docs").unwrap() {
+        let path = entry.unwrap().path();
+        let history = path.file_name().is_some_and(|n| n == "history.md");
+        if path.extension().is_some_and(|e| e == "md") && !history {
+            pages.push(path);
+        }
+    }
+    pages
+}
+
+/// The command lines of our binary in `line` (with its continuations joined): what follows
+/// `moving_circles` (not where it is a path handed to another program's flag) or `cargo run
+/// [--release] --`, to the end of the line or of its code span, comment or pipe.
+fn command_lines(line: &str) -> Vec<Vec<&str>> {
+    let mut found = Vec::new();
+    for marker in [
+        "moving_circles ",
+        "cargo run --release -- ",
+        "cargo run -- ",
+    ] {
+        for (at, _) in line.match_indices(marker) {
+            let token_start = line[..at].rfind(char::is_whitespace).map_or(0, |k| k + 1);
+            let before = line[..token_start].split_whitespace().next_back();
+            if before.is_some_and(|w| w.starts_with("--")) {
+                continue;
+            }
+            let rest = &line[at + marker.len()..];
+            let end = rest.find(['`', '#', '|', ';', ')']).unwrap_or(rest.len());
+            found.push(rest[..end].split_whitespace().collect());
+        }
+    }
+    found
 }
 
 #[test]
@@ -257,29 +290,24 @@ fn every_command_line_in_the_guide_uses_flags_its_command_takes() {
         .iter()
         .map(|&c| (c, flags_in(&help_of(c))))
         .collect();
-    let mut pages = vec![std::path::PathBuf::from("README.md")];
-    for entry in std::fs::read_dir("docs").unwrap() {
-        let path = entry.unwrap().path();
-        let history = path.file_name().is_some_and(|n| n == "history.md");
-        if path.extension().is_some_and(|e| e == "md") && !history {
-            pages.push(path);
-        }
-    }
+    assert!(flags["run"].contains("--scene") && !flags["sweep"].contains("--index"));
     let mut wrong = Vec::new();
     let mut checked = 0;
-    for page in &pages {
-        let text = std::fs::read_to_string(page).unwrap();
+    for page in guide_pages() {
+        let text = std::fs::read_to_string(&page).unwrap();
+        // A line ending in `\` goes on in the next: each logical line with its first line's
+        // number.
+        let mut logical: Vec<(usize, String)> = Vec::new();
+        let mut open = false;
         for (n, line) in text.lines().enumerate() {
-            for (at, _) in line.match_indices("moving_circles ") {
-                // A path to the binary handed to another program is not a command line here.
-                if line[..at].ends_with('/') {
-                    continue;
-                }
-                // The command line runs to the end of the line or of its code span, comment
-                // or pipe.
-                let rest = &line[at + "moving_circles ".len()..];
-                let end = rest.find(['`', '#', '|', ';', ')']).unwrap_or(rest.len());
-                let words: Vec<&str> = rest[..end].split_whitespace().collect();
+            match logical.last_mut() {
+                Some((_, joined)) if open => joined.push_str(line),
+                _ => logical.push((n, line.to_owned())),
+            }
+            open = line.ends_with('\\');
+        }
+        for (n, line) in &logical {
+            for words in command_lines(line) {
                 // The longest command the words start with (`sweep run` before `sweep`).
                 let command = COMMANDS
                     .iter()
@@ -294,7 +322,7 @@ fn every_command_line_in_the_guide_uses_flags_its_command_takes() {
                     let flag = flag.split('=').next().unwrap();
                     checked += 1;
                     if !flags[command].contains(flag) {
-                        let at = format!("{}:{}", page.display(), n + 1);
+                        let at = format!("{}:{}", page.display(), *n + 1);
                         wrong.push(format!("{at}: `moving_circles {command}` takes no {flag}"));
                     }
                 }

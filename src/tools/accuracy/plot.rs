@@ -24,7 +24,8 @@ pub const ROW_HEIGHT: u32 = 232;
 /// Height of the title and legend strip above the panels.
 const STRIP: u32 = 130;
 
-/// One colour per solver setting: a family shares a hue (substeps and soft from light to dark).
+/// One colour per solver setting of the study ([`Solver::STUDY`](crate::base::config::Solver::STUDY), in its order; a test holds
+/// them equal): a family shares a hue (substeps and soft from light to dark).
 const SETTINGS: [(&str, RGBColor); 9] = [
     ("discrete", RGBColor(215, 48, 39)),
     ("substeps=2", RGBColor(161, 217, 155)),
@@ -37,7 +38,7 @@ const SETTINGS: [(&str, RGBColor); 9] = [
     ("exact", RGBColor(117, 80, 170)),
 ];
 
-/// The reference's colour (the last setting, `exact`).
+/// The reference's colour (the last setting, `exact`, the reference).
 const EXACT: RGBColor = SETTINGS[SETTINGS.len() - 1].1;
 /// A solver the study does not run.
 const OTHER: RGBColor = RGBColor(120, 120, 120);
@@ -331,5 +332,19 @@ fn decade_label(v: f64, zero: Option<f64>) -> String {
     match e.round() as i32 {
         k @ -2..=3 => format!("{}", 10f64.powi(k)),
         k => format!("1e{k}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::base::config::Solver;
+
+    #[test]
+    fn every_setting_of_the_study_has_its_colour_and_the_reference_comes_last() {
+        let names: Vec<String> = Solver::STUDY.iter().map(Solver::to_string).collect();
+        let coloured: Vec<&str> = SETTINGS.iter().map(|(name, _)| *name).collect();
+        assert_eq!(names, coloured);
+        assert_eq!(Solver::STUDY.last(), Some(&Solver::REFERENCE));
     }
 }
