@@ -118,8 +118,8 @@
 //! - [`render`] (feature `render`): the window, sprites, HUD, keys and the live panel;
 //! - [`cli`] (feature `cli`): the work behind each `moving_circles` command.
 //!
-//! [`kernels`] opens the plain-data kernels under the solvers to benchmarks, fuzz targets and
-//! tests outside the crate; the rest of the collision layer and the solvers' insides are the
+//! [`kernels`] opens the plain-data kernels under the solvers to benchmarks and tests outside
+//! the crate; the rest of the collision layer and the solvers' insides are the
 //! crate's own.
 //!
 //! # The guide
@@ -162,9 +162,10 @@ pub mod tools;
 pub use game::plugins::CirclesPlugins;
 
 /// The plain-data kernels under the solvers, public for what measures them from outside the
-/// crate (the criterion benches, the system tests) and for a study of your own: the broad phase, the contact and rough impulses, times of impact (under
-/// gravity too), the overlap measures, the discrete contact pass and the event engine. They
-/// work on plain arrays, without an App. Their signatures follow the solvers' needs and change with them.
+/// crate (the criterion benches, the system tests) and for a study of your own: the broad
+/// phase, the contact and rough impulses, times of impact (under gravity too), the overlap
+/// measures, the discrete contact pass and the event engine. They work on plain arrays,
+/// without an App. Their signatures follow the solvers' needs and change with them.
 pub mod kernels {
     pub use crate::collision::broad_phase::{CellList, overlapping_pairs, visit_overlapping_pairs};
     pub use crate::collision::contact::{

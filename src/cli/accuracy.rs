@@ -32,17 +32,10 @@ pub fn accuracy(out: &Path, scenes: &Path, quick: bool, jobs: usize) -> anyhow::
         &["accuracy.csv", "accuracy.svg", "accuracy.png", "piles.csv"],
     )?;
     let tasks = out.join("accuracy-tasks");
-    // A finished study is run again (the code or the machine may have changed); an unfinished
-    // one goes on. Every scene is planned before the first runs, so that a folder holding
-    // another study's plan is refused before anything runs.
-    if specs
-        .iter()
-        .all(|(name, _)| sweep::finished(&tasks.join(name)))
-        && tasks.exists()
-    {
-        std::fs::remove_dir_all(&tasks)
-            .with_context(|| format!("removing the finished study's {}", tasks.display()))?;
-    }
+    // Every scene is planned before the first runs, so that a folder holding another study's
+    // plan is refused before anything runs.
+    let dirs: Vec<_> = specs.iter().map(|(name, _)| tasks.join(name)).collect();
+    sweep::start_over_if_finished(&tasks, &dirs)?;
     for (name, spec) in &specs {
         sweep::plan_spec(spec, &format!("the study's {name}"), &tasks.join(name))?;
     }

@@ -7,8 +7,6 @@
 
 use std::path::Path;
 
-use anyhow::Context;
-
 use super::sweep::spec::{
     Axis, Combine, EosMeasure, SlurmSettings, SweepFigure, SweepSpec, TaskMeasure,
 };
@@ -26,12 +24,7 @@ pub fn eos(options: &EosOptions, out: &Path, jobs: usize) -> anyhow::Result<()> 
     spec.check()
         .map_err(|e| anyhow::anyhow!("the options as a sweep: {e}"))?;
     let tasks = out.join("eos-tasks");
-    // A finished run's tasks are measured again (the code or the machine may have changed);
-    // an unfinished one's go on.
-    if sweep::finished(&tasks) {
-        std::fs::remove_dir_all(&tasks)
-            .with_context(|| format!("removing the finished run's {}", tasks.display()))?;
-    }
+    sweep::start_over_if_finished(&tasks, std::slice::from_ref(&tasks))?;
     sweep::plan_spec(&spec, "these `eos` options", &tasks)?;
     sweep::run(&tasks, jobs)?;
     let points = sweep::eos_points(&tasks)?;

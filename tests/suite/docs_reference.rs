@@ -336,16 +336,16 @@ fn every_command_line_in_the_guide_uses_flags_its_command_takes() {
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
 
-/// The crate documentation's front page: the `//!` lines of `src/lib.rs`.
-fn front_page() -> String {
-    let text = std::fs::read_to_string("src/lib.rs").unwrap();
-    let lines = text.lines().filter_map(|l| l.strip_prefix("//!"));
+/// The crate documentation's front page: the `//!` lines of `lib`, the text of `src/lib.rs`.
+fn front_page(lib: &str) -> String {
+    let lines = lib.lines().filter_map(|l| l.strip_prefix("//!"));
     lines.collect::<Vec<_>>().join("\n")
 }
 
 #[test]
 fn the_crate_front_page_names_every_guide_page_and_links_every_public_module() {
-    let page = front_page();
+    let lib = std::fs::read_to_string("src/lib.rs").unwrap();
+    let page = front_page(&lib);
     let mut missing = Vec::new();
     for entry in std::fs::read_dir("docs").unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
@@ -354,7 +354,6 @@ fn the_crate_front_page_names_every_guide_page_and_links_every_public_module() {
             missing.push(format!("docs/{name}"));
         }
     }
-    let lib = std::fs::read_to_string("src/lib.rs").unwrap();
     let modules = lib
         .lines()
         .filter_map(|l| l.trim().strip_prefix("pub mod "));

@@ -385,8 +385,19 @@ fn run_task(plan: &Plan, task: &Task) -> anyhow::Result<Finished> {
     crate::cli::run::run(options)
 }
 
+/// Removes `root` when it holds `sweeps` (folders under it, or `root` itself) and every one is
+/// finished: a finished run is run again whole (the code or the machine may have changed); an
+/// unfinished one goes on where it stopped.
+pub(crate) fn start_over_if_finished(root: &Path, sweeps: &[PathBuf]) -> anyhow::Result<()> {
+    if root.exists() && sweeps.iter().all(|dir| finished(dir)) {
+        std::fs::remove_dir_all(root)
+            .with_context(|| format!("removing the finished run's {}", root.display()))?;
+    }
+    Ok(())
+}
+
 /// Whether `dir` holds a planned sweep whose every task is done.
-pub(crate) fn finished(dir: &Path) -> bool {
+fn finished(dir: &Path) -> bool {
     Plan::open(dir).is_ok_and(|plan| {
         plan.tasks
             .iter()

@@ -24,8 +24,9 @@ pub const ROW_HEIGHT: u32 = 232;
 /// Height of the title and legend strip above the panels.
 const STRIP: u32 = 130;
 
-/// One colour per solver setting of the study ([`Solver::STUDY`](crate::base::config::Solver::STUDY), in its order; a test holds
-/// them equal): a family shares a hue (substeps and soft from light to dark).
+/// One colour per solver setting of the study
+/// ([`Solver::STUDY`](crate::base::config::Solver::STUDY), in its order; a test holds them
+/// equal): a family shares a hue (substeps and soft from light to dark).
 const SETTINGS: [(&str, RGBColor); 9] = [
     ("discrete", RGBColor(215, 48, 39)),
     ("substeps=2", RGBColor(161, 217, 155)),
@@ -38,7 +39,7 @@ const SETTINGS: [(&str, RGBColor); 9] = [
     ("exact", RGBColor(117, 80, 170)),
 ];
 
-/// The reference's colour (the last setting, `exact`, the reference).
+/// The reference's colour (the last setting, `exact`).
 const EXACT: RGBColor = SETTINGS[SETTINGS.len() - 1].1;
 /// A solver the study does not run.
 const OTHER: RGBColor = RGBColor(120, 120, 120);
