@@ -17,6 +17,7 @@ use crate::base::components::{Restitution, SolverCircles};
 use crate::base::config::{Effects, Solver};
 use crate::base::hits::{CircleHit, HitLog, PairCollisions};
 use crate::base::order::CircleOrder;
+use crate::step::bodies::GatherOwn;
 use crate::step::effects::{Effect, register_effect};
 use crate::step::schedule::{
     CircleStep, CircleSystems, SolverStep, StepDt, SubstepStart, register_solver,
@@ -72,59 +73,28 @@ fn collide_circles(
     clock: (Res<StepDt>, Res<SubstepStart>),
     mut counted: ResMut<PairCollisions>,
     mut scratch: Local<ContactScratch>,
-    mut log: Local<(HitLog, Vec<Entity>)>,
+    mut log: Local<HitLog>,
     mut messages: MessageWriter<CircleHit>,
     (own_restitution, filters): (Query<(), With<Restitution>>, CircleFilters),
     (order, mut circles): (Res<CircleOrder>, SolverCircles),
 ) {
-    scratch.clear();
-    let (log, entities) = &mut *log;
-    entities.clear();
-    let per_circle = !own_restitution.is_empty();
-    let filtered = filters.any();
-    order.each(&circles, |_, (e, p, v, r, m, own, sleep)| {
-        // A sleeping circle is an immovable circle at rest until it is woken.
-        let mass = if sleep.asleep { f64::INFINITY } else { m.0 };
-        scratch.push(p.0, v.0, r.0, mass);
-        if per_circle {
-            scratch.push_restitution(own.map_or(effects.restitution, |own| own.0));
-        }
-        if filtered {
-            scratch.push_layers(filters.of(e));
-        }
-        if effects.hit_messages {
-            entities.push(e);
-        }
-    });
+    let own = GatherOwn {
+        restitution: (!own_restitution.is_empty()).then_some(effects.restitution),
+        filters: &filters,
+    };
+    scratch.bodies.gather(&order, &circles, &own, |_, _| {});
     let record = effects.hit_messages.then_some(&mut *log);
     let stats = resolve_all_contacts(&mut scratch, &arena, effects.restitution, record);
     counted.count += stats.collisions;
     counted.virial += stats.virial;
     counted.immovable_work += stats.immovable_work;
     counted.immovable_impulse += stats.immovable_impulse;
+    let bodies = &scratch.bodies;
     if effects.hit_messages {
         let (dt, start) = clock;
-        log.send_circle_hits(|i| entities[i as usize], start.0 + dt.0, &mut messages);
+        log.send_circle_hits(|i| bodies.entity[i as usize], start.0 + dt.0, &mut messages);
     }
-    if stats.contacts == 0 {
-        return;
+    if stats.contacts > 0 {
+        bodies.write_back(&order, &mut circles, &arena);
     }
-    // `each_mut` folds over the query's tables (`for_each`); a `for` loop steps it one item at
-    // a time through a call the compiler may leave out of line (it did, after an unrelated
-    // change: +9 % of the 10k gas's instructions).
-    let (arena, scratch) = (*arena, &*scratch);
-    let periodic = arena.is_periodic();
-    order.each_mut(&mut circles, |i, (_, mut p, mut v, ..)| {
-        let mut position = scratch.position(i);
-        if periodic && !arena.contains(position) {
-            position = arena.wrap(position);
-        }
-        if p.0 != position {
-            p.0 = position;
-        }
-        let velocity = scratch.velocity(i);
-        if v.0 != velocity {
-            v.0 = velocity;
-        }
-    });
 }

@@ -13,20 +13,17 @@ use crate::collision::broad_phase::{
     CellList, needs_levels, overlapping_pairs, pairs_in_cell_order, radius_range,
 };
 use crate::collision::contact::{combine_restitution, resolve_contact, work_by_immovable};
+use crate::step::bodies::BodyStore;
 use crate::step::boundary::put_back_inside;
 
-/// The circles of one collision pass, and buffers reused from pass to pass so the hot path
-/// does not allocate. Centres and radii sit together (what the broad phase reads); velocities
-/// and masses apart (read only for the pairs that touch).
+/// The circles of one collision pass ([`BodyStore`]), and buffers reused from pass to pass so
+/// the hot path does not allocate: centres and radii together (what the broad phase reads) and
+/// in cell order, and the pairs.
 #[derive(Default)]
 pub struct ContactScratch {
+    pub(crate) bodies: BodyStore,
+    /// Centres and radii, what the broad phase reads.
     discs: Vec<(DVec2, f64)>,
-    velocities: Vec<DVec2>,
-    masses: Vec<f64>,
-    /// Each circle's own restitution, or empty when every circle takes the pass's.
-    restitutions: Vec<f64>,
-    /// Each circle's layers, or empty when every pair meets.
-    layers: Vec<CollisionLayers>,
     /// `discs` in cell order, while contacts are resolved.
     sorted: Vec<(DVec2, f64)>,
     /// `0, 1, 2, …`: the order of the multi-level path, which resolves in input order.
@@ -38,43 +35,37 @@ pub struct ContactScratch {
 impl ContactScratch {
     /// Forgets the circles of the last pass.
     pub fn clear(&mut self) {
-        self.discs.clear();
-        self.velocities.clear();
-        self.masses.clear();
-        self.restitutions.clear();
-        self.layers.clear();
+        self.bodies.clear();
     }
 
     /// Adds a circle to the next [`resolve_all_contacts`].
     #[inline]
     pub fn push(&mut self, position: DVec2, velocity: DVec2, radius: f64, mass: f64) {
-        self.discs.push((position, radius));
-        self.velocities.push(velocity);
-        self.masses.push(mass);
+        self.bodies.push(position, velocity, radius, mass);
     }
 
     /// Gives the circle pushed last its own restitution. Either every circle gets one (pushed
     /// right after it) or none does; a pair then bounces with `combine_restitution` of theirs.
     #[inline]
     pub fn push_restitution(&mut self, restitution: f64) {
-        self.restitutions.push(restitution);
+        self.bodies.restitution.push(restitution);
     }
 
     /// Gives the circle pushed last its layers. Either every circle gets them (pushed right
     /// after it) or none does (every pair meets); a pair that does not meet is left alone.
     #[inline]
     pub fn push_layers(&mut self, layers: CollisionLayers) {
-        self.layers.push(layers);
+        self.bodies.layers.push(layers);
     }
 
     /// Centre of circle `i` now.
     pub fn position(&self, i: usize) -> DVec2 {
-        self.discs[i].0
+        self.bodies.position[i]
     }
 
     /// Velocity of circle `i` now.
     pub fn velocity(&self, i: usize) -> DVec2 {
-        self.velocities[i]
+        self.bodies.velocity[i]
     }
 }
 
@@ -108,17 +99,23 @@ pub fn resolve_all_contacts(
     mut hits: Option<&mut HitLog>,
 ) -> PassStats {
     let ContactScratch {
+        bodies,
         discs,
-        velocities,
-        masses,
-        restitutions,
-        layers,
         sorted,
         identity,
         pairs,
         cells,
     } = scratch;
     pairs.clear();
+    discs.clear();
+    discs.extend(
+        bodies
+            .position
+            .iter()
+            .zip(&bodies.radius)
+            .map(|(&p, &r)| (p, r)),
+    );
+    let layers = &bodies.layers;
     let radii = radius_range(discs);
     let order: &[u32] = if needs_levels(radii) {
         overlapping_pairs(cells, arena, discs, pairs);
@@ -146,20 +143,23 @@ pub fn resolve_all_contacts(
     for &(k, l) in pairs.iter() {
         let (k, l) = (k as usize, l as usize);
         let (i, j) = (order[k] as usize, order[l] as usize);
-        let mut a = circle(sorted[k], velocities[i], masses[i]);
+        let mut a = circle(sorted[k], bodies.velocity[i], bodies.moving_mass(i));
         // Work on the image of `b` nearest to `a`.
         let image = a.position + arena.offset(a.position, sorted[l].0);
         let shift = sorted[l].0 - image;
-        let mut b = circle((image, sorted[l].1), velocities[j], masses[j]);
-        let e = if restitutions.is_empty() {
-            restitution
-        } else {
-            combine_restitution(restitutions[i], restitutions[j])
+        let mut b = circle(
+            (image, sorted[l].1),
+            bodies.velocity[j],
+            bodies.moving_mass(j),
+        );
+        let e = match &bodies.restitution[..] {
+            [] => restitution,
+            own => combine_restitution(own[i], own[j]),
         };
         let (va, vb) = (a.velocity, b.velocity);
         let outcome = resolve_contact(&mut a, &mut b, e);
-        (sorted[k].0, velocities[i]) = (a.position, a.velocity);
-        (sorted[l].0, velocities[j]) = (b.position + shift, b.velocity);
+        (sorted[k].0, bodies.velocity[i]) = (a.position, a.velocity);
+        (sorted[l].0, bodies.velocity[j]) = (b.position + shift, b.velocity);
         stats.contacts += u64::from(outcome.penetration > 0.0);
         if outcome.impulse > 0.0 {
             stats.collisions += 1;
@@ -193,7 +193,7 @@ pub fn resolve_all_contacts(
             if arena.has_walls() && !arena.contains(*position) {
                 put_back_inside(position, *radius, arena);
             }
-            discs[order[k] as usize].0 = *position;
+            bodies.position[order[k] as usize] = *position;
         }
     }
     stats

@@ -20,6 +20,7 @@ use crate::base::components::{
 use crate::base::config::{Effects, Solver};
 use crate::base::order::CircleOrder;
 use crate::base::segment::Segments;
+use crate::step::bodies::{BodyStore, GatherOwn};
 use crate::step::schedule::StopRequest;
 
 /// `exact` updates its engine in place when at most one circle in this many was moved from
@@ -337,23 +338,36 @@ pub(super) fn gather_into_engine(
             resting_for: sleep.slow_for,
         },
     };
-    let all = circles.p0();
-    let count = order.entities().len();
-    let mut bodies = Vec::with_capacity(count);
-    let mut rest = Vec::with_capacity(count);
-    let mut entities = Vec::with_capacity(count);
-    let mut own_restitutions = Vec::with_capacity(if own.restitution { count } else { 0 });
-    order.each(&all, |_, (e, p, v, r, m, restitution, sleep)| {
-        bodies.push(CircleState::new(p.0, v.0, r.0).with_mass(m.0));
-        rest.push(rest_of(sleep, v.0 != DVec2::ZERO));
-        entities.push(e);
-        if own.restitution {
-            own_restitutions.push(restitution_of(restitution));
-        }
+    let mut store = BodyStore::default();
+    let mut sleeps = Vec::with_capacity(order.entities().len());
+    let gather = GatherOwn {
+        restitution: own.restitution.then_some(effects.restitution),
+        filters: own.filters,
+    };
+    store.gather(order, &circles.p0(), &gather, |_, sleep| {
+        sleeps.push(*sleep)
     });
     if stopped() {
         return give_up(state);
     }
+    let BodyStore {
+        entity: entities,
+        position,
+        velocity,
+        radius,
+        mass,
+        restitution: own_restitutions,
+        layers,
+        ..
+    } = store;
+    let bodies: Vec<CircleState> = (0..entities.len())
+        .map(|i| CircleState::new(position[i], velocity[i], radius[i]).with_mass(mass[i]))
+        .collect();
+    let mut rest: Vec<Rest> = sleeps
+        .iter()
+        .zip(&velocity)
+        .map(|(sleep, &v)| rest_of(sleep, v != DVec2::ZERO))
+        .collect();
     let spins = circles.p3();
     for (r, &e) in rest.iter_mut().zip(&entities).filter(|(r, _)| r.asleep) {
         if let Ok((Some(spin), ..)) = spins.get(e)
@@ -362,7 +376,6 @@ pub(super) fn gather_into_engine(
             *r = Rest::default();
         }
     }
-    let layers = own.filters.gather(entities.iter().copied());
     let restitutions = (effects.restitution, effects.wall_restitution);
     let fall = (effects.gravity, &rest[..]);
     let Some(mut engine) = EventEngine::build_until(

@@ -21,21 +21,19 @@ mod keep;
 mod outside;
 pub(crate) mod pack;
 
-use bevy::ecs::query::QueryItem;
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use crate::base::arena::Arena;
 use crate::base::collision_layers::{CircleFilters, CollisionLayers, Sensor};
-use crate::base::components::{
-    Inertia, Radius, Restitution, Sleep, SolverCircles, SolverData, SpinCircles,
-};
+use crate::base::components::{Inertia, Radius, Restitution, Sleep, SolverCircles, SpinCircles};
 use crate::base::config::{Effects, Solver};
 use crate::base::hits::PairCollisions;
 use crate::base::hits::{CircleHit, WallHit};
 use crate::base::order::CircleOrder;
 use crate::base::segment::Segments;
+use crate::step::bodies::write_motion;
 use crate::step::boundary::WallCollisions;
 use crate::step::effects::{Effect, register_effect};
 use crate::step::forces::drag_systems;
@@ -398,22 +396,8 @@ fn write_back(state: &EngineState, order: &CircleOrder, circles: &mut SolverCirc
     let Some(engine) = state.engine.as_ref() else {
         return;
     };
-    let write = |i: usize, (_, mut p, mut v, ..): QueryItem<'_, '_, SolverData>| {
-        let (position, velocity) = (engine.position(i), engine.velocity(i));
-        if p.0 != position {
-            p.0 = position;
-        }
-        if v.0 != velocity {
-            v.0 = velocity;
-        }
-    };
-    if order.entities() == state.entities {
-        order.each_mut(circles, write);
-    } else {
-        for (i, &entity) in state.entities.iter().enumerate() {
-            if let Ok(item) = circles.get_mut(entity) {
-                write(i, item);
-            }
-        }
-    }
+    let entities = (order.entities() != state.entities).then_some(&state.entities[..]);
+    write_motion(order, entities, circles, |i| {
+        (engine.position(i), engine.velocity(i))
+    });
 }

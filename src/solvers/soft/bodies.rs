@@ -2,22 +2,19 @@
 //! [`Softness`], the coefficients that make a contact a damped spring for one substep.
 
 use std::f64::consts::TAU;
-
-use bevy::math::DVec2;
+use std::ops::{Deref, DerefMut};
 
 use crate::base::circle::inverse_inertia;
-use crate::base::collision_layers::CollisionLayers;
+use crate::base::components::Mass;
+use crate::step::bodies::BodyStore;
 
-/// The circles of one `soft` step, as plain arrays in one order (the solver's query's).
+/// The circles of one `soft` step: the step's [`BodyStore`] (reached through `Deref`), and
+/// what `soft` adds beside it, all in one order (serial order).
 #[derive(Clone, Debug, Default)]
 pub struct Bodies {
-    /// Centres.
-    pub position: Vec<DVec2>,
-    /// Velocities.
-    pub velocity: Vec<DVec2>,
-    /// Radii.
-    pub radius: Vec<f64>,
-    /// Inverse masses: 0 for an immovable (static or kinematic) circle.
+    /// Centres, velocities, radii, masses, own restitutions and layers.
+    pub(crate) circles: BodyStore,
+    /// Inverse masses: 0 for an immovable (static, kinematic or sleeping) circle.
     pub inv_mass: Vec<f64>,
     /// Angular velocities (counter-clockwise, radians per second); these three are empty in a
     /// step in which nothing turns ([`Bodies::start_turning`]).
@@ -27,39 +24,64 @@ pub struct Bodies {
     /// Inverse moments of inertia: `2 / (m r²)` for a uniform disc, 0 for a circle that
     /// cannot turn (immovable, asleep, or without an angular velocity).
     pub inv_inertia: Vec<f64>,
-    /// Each circle's own restitution, or empty when every circle takes the scene's.
-    pub restitution: Vec<f64>,
     /// Each circle's own friction coefficient (NaN for one without), or empty when every
     /// circle takes the scene's.
     pub friction: Vec<f64>,
-    /// Each circle's layers, or empty when every pair meets.
-    pub layers: Vec<CollisionLayers>,
-    /// A stable identity per circle (its entity), so a contact is recognised next step.
+    /// A stable identity per circle (its serial), so a contact is recognised next step.
     pub id: Vec<u64>,
 }
 
+impl Deref for Bodies {
+    type Target = BodyStore;
+
+    fn deref(&self) -> &BodyStore {
+        &self.circles
+    }
+}
+
+impl DerefMut for Bodies {
+    fn deref_mut(&mut self) -> &mut BodyStore {
+        &mut self.circles
+    }
+}
+
 impl Bodies {
-    /// Forgets every circle (keeping the buffers).
-    pub fn clear(&mut self) {
-        self.position.clear();
-        self.velocity.clear();
-        self.radius.clear();
+    /// Takes what `soft` adds beside the store from the circles gathered into it, with their
+    /// `serials`: inverse masses (0 while asleep) and identities; nothing turns yet.
+    pub fn beside_gathered(&mut self, serials: &[u64]) {
+        let store = &self.circles;
         self.inv_mass.clear();
+        self.inv_mass.extend(
+            store
+                .mass
+                .iter()
+                .zip(&store.asleep)
+                .map(|(&m, &asleep)| if asleep { 0.0 } else { Mass(m).inverse() }),
+        );
+        self.id.clear();
+        self.id.extend_from_slice(serials);
         self.angular_velocity.clear();
         self.rotation.clear();
         self.inv_inertia.clear();
-        self.restitution.clear();
         self.friction.clear();
-        self.layers.clear();
-        self.id.clear();
     }
 
-    /// Adds a circle that does not turn.
-    pub fn push(&mut self, id: u64, position: DVec2, velocity: DVec2, radius: f64, inv_mass: f64) {
+    /// Adds a circle that does not turn (without an App: the kernel's tests).
+    #[cfg(test)]
+    pub fn push(
+        &mut self,
+        id: u64,
+        (position, velocity): (bevy::math::DVec2, bevy::math::DVec2),
+        radius: f64,
+        inv_mass: f64,
+    ) {
+        let mass = if inv_mass > 0.0 {
+            1.0 / inv_mass
+        } else {
+            f64::INFINITY
+        };
+        self.circles.push(position, velocity, radius, mass);
         self.id.push(id);
-        self.position.push(position);
-        self.velocity.push(velocity);
-        self.radius.push(radius);
         self.inv_mass.push(inv_mass);
     }
 
@@ -87,11 +109,6 @@ impl Bodies {
         self.angular_velocity[i] = angular_velocity;
         self.rotation[i] = rotation;
         self.inv_inertia[i] = inverse_inertia(own, self.inv_mass[i], self.radius[i]);
-    }
-
-    /// Number of circles.
-    pub fn len(&self) -> usize {
-        self.position.len()
     }
 
     /// Circle `i`'s own restitution, or `scene`'s if circles have none.

@@ -136,7 +136,7 @@ mod tests {
     /// at `w`, with friction `mu` and a normal push of 1 held.
     fn on_floor(v: f64, w: f64, mu: f64) -> (Bodies, Constraint, TurningRow) {
         let mut bodies = Bodies::default();
-        bodies.push(1, DVec2::ZERO, DVec2::new(v, 0.0), 1.0, 1.0);
+        bodies.push(1, (DVec2::ZERO, DVec2::new(v, 0.0)), 1.0, 1.0);
         bodies.start_turning();
         bodies.turning(0, (w, 0.0), None);
         let c = Constraint {

@@ -34,6 +34,7 @@ use crate::base::hits::PairCollisions;
 use crate::base::hits::{CircleHit, HitLog, WallHit};
 use crate::base::order::CircleOrder;
 use crate::base::segment::{SegmentCells, Segments};
+use crate::step::bodies::GatherOwn;
 use crate::step::boundary::WallCollisions;
 use crate::step::schedule::{SolverStep, StepDt, register_solver};
 pub(crate) use bodies::Bodies;
@@ -85,7 +86,6 @@ pub struct SoftState {
     cache: ContactCache,
     scratch: SoftScratch,
     bodies: Bodies,
-    entities: Vec<Entity>,
     segment_cells: Option<(Arena, Segments, SegmentCells)>,
     log: HitLog,
     /// What the last step did.
@@ -172,34 +172,23 @@ fn step_soft(
         cache,
         scratch,
         bodies,
-        entities,
         segment_cells: kept_cells,
         log,
         last,
     } = &mut *state;
     let per_circle = (!own.0.is_empty(), !own.1.is_empty());
-    bodies.clear();
-    entities.clear();
-    let serials = order.serials();
-    order.each(&circles, |i, (entity, p, v, r, m, restitution, sleep)| {
-        // A sleeping circle is an immovable circle at rest until it is woken.
-        let inverse = if sleep.asleep { 0.0 } else { m.inverse() };
-        bodies.push(serials[i], p.0, v.0, r.0, inverse);
-        if per_circle.0 {
-            let scene = effects.restitution;
-            bodies
-                .restitution
-                .push(restitution.map_or(scene, |own| own.0));
-        }
-        entities.push(entity);
-    });
-    bodies.layers = filters.gather(entities.iter().copied());
+    let gather = GatherOwn {
+        restitution: per_circle.0.then_some(effects.restitution),
+        filters: &filters,
+    };
+    bodies.circles.gather(&order, &circles, &gather, |_, _| {});
+    bodies.beside_gathered(order.serials());
     // Spin only where something may turn: friction, or a circle turning already.
     let spinning = effects.has_friction()
         || per_circle.1
         || spins.iter().any(|(w, ..)| w.is_some_and(|w| w.0 != 0.0));
     if spinning {
-        gather_spin(bodies, entities, &spins, per_circle.1);
+        gather_spin(bodies, &spins, per_circle.1);
     }
     // Everything asleep or static: nothing can move this step.
     let moving = |i: usize| {
@@ -243,27 +232,21 @@ fn step_soft(
     walls.count = walls.count.saturating_add(stats.wall_hits);
     walls.impulse += stats.wall_impulse;
     if effects.hit_messages {
-        log.send_circle_hits(|i| entities[i as usize], 0.0, &mut messages.0);
-        log.send_wall_hits(|i| entities[i as usize], 0.0, &mut messages.1);
+        let entity = |i: u32| bodies.entity[i as usize];
+        log.send_circle_hits(entity, 0.0, &mut messages.0);
+        log.send_wall_hits(entity, 0.0, &mut messages.1);
     }
-    order.each_mut(&mut circles, |i, (_, mut p, mut v, ..)| {
-        let (position, velocity) = (bodies.position[i], bodies.velocity[i]);
-        if p.0 != position {
-            p.0 = position;
-        }
-        if v.0 != velocity {
-            v.0 = velocity;
-        }
-    });
+    bodies.circles.write_back(&order, &mut circles, &arena);
     if !bodies.angular_velocity.is_empty() {
-        write_back_spin(bodies, entities, &mut spins);
+        write_back_spin(bodies, &mut spins);
     }
 }
 
 /// Each circle's spin (and own friction, when `own_friction`) into `bodies`, by entity.
-fn gather_spin(bodies: &mut Bodies, entities: &[Entity], spins: &SpinCircles, own_friction: bool) {
+fn gather_spin(bodies: &mut Bodies, spins: &SpinCircles, own_friction: bool) {
     bodies.start_turning();
-    for (i, &entity) in entities.iter().enumerate() {
+    for i in 0..bodies.len() {
+        let entity = bodies.entity[i];
         let (spin, rotation, friction, own) = match spins.get(entity) {
             Ok((spin, rotation, friction, own, _)) => (spin, rotation, friction, own),
             Err(_) => (None, None, None, None),
@@ -278,8 +261,8 @@ fn gather_spin(bodies: &mut Bodies, entities: &[Entity], spins: &SpinCircles, ow
 }
 
 /// Each circle's new spin and rotation from `bodies`, written only where they changed.
-fn write_back_spin(bodies: &Bodies, entities: &[Entity], spins: &mut SpinCircles) {
-    for (i, &entity) in entities.iter().enumerate() {
+fn write_back_spin(bodies: &Bodies, spins: &mut SpinCircles) {
+    for (i, &entity) in bodies.entity.iter().enumerate() {
         let Ok((Some(mut spin), Some(mut rotation), ..)) = spins.get_mut(entity) else {
             continue;
         };

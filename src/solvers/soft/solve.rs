@@ -26,6 +26,7 @@ use crate::base::arena::Arena;
 use crate::base::config::{Combine, SoftConfig};
 use crate::base::hits::HitLog;
 use crate::base::segment::{Segment, SegmentCells};
+use crate::step::bodies::BodyStore;
 use crate::step::boundary::put_back_inside;
 
 /// What one `soft` step is asked to do besides moving the circles.
@@ -257,9 +258,9 @@ fn colour_pass(
     pass: Pass,
     work: &mut Work,
 ) {
-    let Bodies {
+    let BodyStore {
         position, velocity, ..
-    } = bodies;
+    } = &mut bodies.circles;
     passes(colours, position, velocity, pass, work);
     for &k in &colours.rest {
         let c = &mut pairs[k as usize];
@@ -289,7 +290,7 @@ fn turning_substep(
 
 /// Gravity and drag for every movable circle, over one substep.
 fn integrate_velocities(bodies: &mut Bodies, dv: DVec2, drag: f64) {
-    for (v, &w) in bodies.velocity.iter_mut().zip(&bodies.inv_mass) {
+    for (v, &w) in bodies.circles.velocity.iter_mut().zip(&bodies.inv_mass) {
         if w > 0.0 {
             *v = *v * drag + dv;
         }
@@ -298,7 +299,10 @@ fn integrate_velocities(bodies: &mut Bodies, dv: DVec2, drag: f64) {
 
 /// Every circle along its velocity for one substep (kinematic ones too).
 fn integrate_positions(bodies: &mut Bodies, h: f64) {
-    for (p, &v) in bodies.position.iter_mut().zip(&bodies.velocity) {
+    let BodyStore {
+        position, velocity, ..
+    } = &mut bodies.circles;
+    for (p, &v) in position.iter_mut().zip(&*velocity) {
         *p += v * h;
     }
 }
@@ -309,7 +313,10 @@ fn keep_inside(bodies: &mut Bodies, arena: &Arena) {
     if arena.is_open() {
         return;
     }
-    for (p, &r) in bodies.position.iter_mut().zip(&bodies.radius) {
+    let BodyStore {
+        position, radius, ..
+    } = &mut bodies.circles;
+    for (p, &r) in position.iter_mut().zip(&*radius) {
         if arena.contains(*p) {
             continue;
         }
