@@ -8,6 +8,7 @@
 
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 #[cfg(doc)]
 use super::front::{MEASURES, REPORT_MEASURES};
@@ -19,10 +20,22 @@ use crate::tools::figure::{Figure, decades, err, font};
 pub const FIGURE_WIDTH: u32 = 1600;
 
 /// The height of each scene's row of panels.
-pub const ROW_HEIGHT: u32 = 232;
+pub const ROW_HEIGHT: u32 = 340;
 
 /// Height of the title and legend strip above the panels.
-const STRIP: u32 = 130;
+const STRIP: u32 = 280;
+
+/// Width of the column naming each row's scene, left of the panels.
+const LABEL: u32 = 44;
+
+/// Text sizes (in pixels of the 1600-wide figure, which a page shows at about half that): the
+/// legend's, the panels' captions and their tick labels.
+const LEGEND_TEXT: u32 = 28;
+const CAPTION_TEXT: u32 = 24;
+const TICK_TEXT: u32 = 21;
+
+/// Longest line of the legend, in characters, before it wraps.
+const LEGEND_LINE: usize = 118;
 
 /// One colour per solver setting of the study
 /// ([`Solver::STUDY`](crate::base::config::Solver::STUDY), in its order; a test holds them
@@ -84,9 +97,20 @@ impl Figure for AccuracyFigure<'_> {
         legend(&strip, &self.note)?;
         let scenes = scenes(rows);
         let columns = self.measures.len().max(1);
+        let (labels, grid) = grid.split_horizontally(LABEL);
+        let labels = labels.split_evenly((scenes.len().max(1), 1));
         let panels = grid.split_evenly((scenes.len().max(1), columns));
+        let centred = Pos::new(HPos::Center, VPos::Center);
         for (s, scene) in scenes.iter().enumerate() {
             let mine = of_scene(rows, scene);
+            let n = mine.first().map_or(0, |r| r.n);
+            let name = font(LEGEND_TEXT)
+                .transform(FontTransform::Rotate270)
+                .pos(centred);
+            let middle = (LABEL as i32 / 2, ROW_HEIGHT as i32 / 2);
+            labels[s]
+                .draw(&Text::new(format!("{scene} (n = {n})"), middle, name))
+                .map_err(err)?;
             for (m, measure) in self.measures.iter().enumerate() {
                 panel(&panels[s * columns + m], &mine, measure)?;
             }
@@ -118,19 +142,22 @@ fn horizons(rows: &[Row]) -> String {
 /// The title and the legend: settings, rates, the reference and the front; `note` is the
 /// second line.
 fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, note: &str) -> Result<(), String> {
-    let lines = [
-        "What accuracy costs: error against exact (y) vs CPU ms of stepping per simulated second (x), log axes; lower left is better.",
-        note,
-    ];
+    let title = "What accuracy costs: error against exact (y) vs CPU ms of stepping per simulated second (x), log axes; lower left is better.";
+    let lines: Vec<String> = wrap(title).into_iter().chain(wrap(note)).collect();
+    let line_height = LEGEND_TEXT as i32 + 6;
     for (i, line) in lines.iter().enumerate() {
         strip
-            .draw(&Text::new(*line, (14, 8 + 22 * i as i32), font(16)))
+            .draw(&Text::new(
+                line.as_str(),
+                (14, 8 + line_height * i as i32),
+                font(LEGEND_TEXT),
+            ))
             .map_err(err)?;
     }
-    let row_y = 66;
+    let row_y = 18 + line_height * lines.len() as i32;
     let mut x = 14;
     for (name, colour) in SETTINGS {
-        let y = row_y + 8;
+        let y = row_y + 12;
         strip
             .draw(&PathElement::new(
                 vec![(x, y), (x + 28, y)],
@@ -141,18 +168,22 @@ fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, note: &str) -> Res
             .draw(&Circle::new((x + 14, y), 4, colour.filled()))
             .map_err(err)?;
         strip
-            .draw(&Text::new(name, (x + 34, row_y), font(14)))
+            .draw(&Text::new(name, (x + 34, row_y), font(CAPTION_TEXT)))
             .map_err(err)?;
-        x += 44 + 9 * name.len() as i32;
+        x += 56 + 13 * name.len() as i32;
     }
-    let y = row_y + 36;
+    let y = row_y + 52;
     let mut x = 14;
     for hz in [30, 60, 120] {
         marker(strip, hz, (x + 6, y), BLACK)?;
         strip
-            .draw(&Text::new(format!("{hz} Hz"), (x + 16, y - 8), font(14)))
+            .draw(&Text::new(
+                format!("{hz} Hz"),
+                (x + 16, y - 12),
+                font(CAPTION_TEXT),
+            ))
             .map_err(err)?;
-        x += 80;
+        x += 120;
     }
     strip
         .draw(&Rectangle::new(
@@ -163,11 +194,12 @@ fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, note: &str) -> Res
     strip
         .draw(&Text::new(
             "Pareto front: no cheaper setting is as accurate",
-            (x + 34, y - 8),
-            font(14),
+            (x + 34, y - 12),
+            font(CAPTION_TEXT),
         ))
         .map_err(err)?;
-    x += 400;
+    // The reference on a line of its own: the two would not fit one line of the figure.
+    let (x, y) = (14, y + 40);
     let exact = EXACT;
     for k in 0..4 {
         strip
@@ -180,8 +212,8 @@ fn legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, note: &str) -> Res
     strip
         .draw(&Text::new(
             "exact at 60 Hz, the reference: its cost (its error is 0 by definition)",
-            (x + 14, y - 8),
-            font(14),
+            (x + 14, y - 12),
+            font(CAPTION_TEXT),
         ))
         .map_err(err)
 }
@@ -195,15 +227,13 @@ fn panel<DB: DrawingBackend>(
     let panel = Panel::new(rows, measure);
     let front = panel.front();
     let (reference, plotted) = (panel.reference, panel.points);
-    let scene = rows.first().map_or("", |r| r.scene.as_str());
-    let n = rows.first().map_or(0, |r| r.n);
-    let caption = format!("{scene} (n = {n}): {}", measure.title);
+    let caption = measure.title;
     if plotted.is_empty() {
         return area
             .draw(&Text::new(
                 format!("{caption}: not measured"),
                 (20, 20),
-                font(14),
+                font(CAPTION_TEXT),
             ))
             .map_err(err);
     }
@@ -215,11 +245,11 @@ fn panel<DB: DrawingBackend>(
         .map_or(zero * 100.0, |(_, hi)| hi);
     let y = |e: f64| if e > zero { e } else { zero };
     let mut chart = ChartBuilder::on(area)
-        .caption(caption, font(14))
+        .caption(caption, font(CAPTION_TEXT))
         .margin(8)
-        .margin_right(16)
-        .x_label_area_size(34)
-        .y_label_area_size(50)
+        .margin_right(20)
+        .x_label_area_size(56)
+        .y_label_area_size(80)
         .build_cartesian_2d(
             (x_lo..x_hi).log_scale().with_key_points(ticks(x_lo, x_hi)),
             (zero..y_hi).log_scale().with_key_points(ticks(zero, y_hi)),
@@ -231,8 +261,8 @@ fn panel<DB: DrawingBackend>(
         .bold_line_style(GRID)
         .x_label_formatter(&|v| decade_label(*v, None))
         .y_label_formatter(&|v| decade_label(*v, Some(zero)))
-        .label_style(font(12))
-        .axis_desc_style(font(12))
+        .label_style(font(TICK_TEXT))
+        .axis_desc_style(font(TICK_TEXT))
         .x_desc("ms per simulated second")
         .y_desc(measure.unit)
         .draw()
@@ -312,6 +342,21 @@ fn marker<DB: DrawingBackend, CT: CoordTranslate>(
     .map_err(err)
 }
 
+/// `text` in lines of at most [`LEGEND_LINE`] characters, broken between words.
+fn wrap(text: &str) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split(' ') {
+        match lines.last_mut() {
+            Some(line) if line.len() + 1 + word.len() <= LEGEND_LINE => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_owned()),
+        }
+    }
+    lines
+}
+
 /// Ticks at whole decades from `lo` to `hi` (both decades), every decade or every few so there
 /// are at most seven, always including `lo`.
 fn ticks(lo: f64, hi: f64) -> Vec<f64> {
@@ -347,5 +392,14 @@ mod tests {
         let coloured: Vec<&str> = SETTINGS.iter().map(|(name, _)| *name).collect();
         assert_eq!(names, coloured);
         assert_eq!(Solver::STUDY.last(), Some(&Solver::REFERENCE));
+    }
+
+    #[test]
+    fn the_legend_wraps_between_words_and_keeps_them_all() {
+        let note = horizons(&[]).repeat(3);
+        let lines = wrap(&note);
+        assert!(lines.len() > 1);
+        assert!(lines.iter().all(|l| l.len() <= LEGEND_LINE), "{lines:?}");
+        assert_eq!(lines.join(" "), note);
     }
 }
