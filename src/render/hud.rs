@@ -14,6 +14,7 @@ use crate::base::config::Solver;
 use crate::base::hits::PairCollisions;
 use crate::collision::overlaps::Overlaps;
 use crate::game::diagnostics::{CircleDiagnostics, Pressure};
+use crate::render::view::PanelEdge;
 use crate::step::boundary::WallCollisions;
 use crate::step::schedule::StepTotals;
 use crate::step::sleep::Sleeping;
@@ -36,6 +37,7 @@ impl Plugin for HudPlugin {
                     )
                         .chain(),
                     show_help,
+                    keep_left_of_panel.run_if(resource_exists_and_changed::<PanelEdge>),
                 ),
             );
     }
@@ -64,6 +66,15 @@ mouse     drag a circle to fling it
 h         this help
 p         live panel: plots, sliders, compare
 q, Esc    quit";
+
+/// Wraps the HUD's lines short of the live panel while it is shown.
+fn keep_left_of_panel(edge: Res<PanelEdge>, mut hud: Single<&mut Node, With<HudText>>) {
+    hud.max_width = match edge.0 {
+        // Its own left offset and a gap as wide.
+        Some(left) => px((left - 12.0).max(0.0)),
+        None => Val::Auto,
+    };
+}
 
 fn spawn_hud(mut commands: Commands) {
     let panel = (

@@ -1,5 +1,5 @@
 //! The windowed app's side (cargo feature `render`): a camera that keeps the whole arena in view
-//! at its aspect ratio, one sprite per circle sharing a single disc texture (so thousands draw
+//! at its aspect ratio ([`view`]), one sprite per circle sharing a single disc texture (so thousands draw
 //! in a handful of batched draw calls, each with its own tint; a darker radius on the disc
 //! turns with the circle's [`Rotation`]), a thin bar per segment wall, and
 //! the [`hud`], [`input`] and [`screenshot`] plugins; the app adds the live [`panel`]. The
@@ -10,9 +10,9 @@ pub mod hud;
 pub mod input;
 pub mod panel;
 pub mod screenshot;
+pub mod view;
 
 use bevy::asset::RenderAssetUsages;
-use bevy::camera::ScalingMode;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 
@@ -27,9 +27,12 @@ pub struct CirclesRenderPlugin;
 impl Plugin for CirclesRenderPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(ClearColor(Color::srgb(0.02, 0.02, 0.03)))
-            .add_plugins((hud::HudPlugin, input::InputPlugin))
+            .add_plugins((view::ViewPlugin, hud::HudPlugin, input::InputPlugin))
             .add_systems(Startup, (create_disc_texture, spawn_camera_and_arena))
-            .add_systems(Update, fit_view_to_arena.run_if(resource_changed::<Arena>))
+            .add_systems(
+                Update,
+                fit_backdrop_to_arena.run_if(resource_changed::<Arena>),
+            )
             .add_systems(
                 Update,
                 draw_segment_walls.run_if(resource_changed::<Segments>),
@@ -82,30 +85,8 @@ fn create_disc_texture(mut commands: Commands, mut images: ResMut<Assets<Image>>
     commands.insert_resource(DiscTexture(images.add(image)));
 }
 
-/// Margin around the arena, as a fraction of its size, so the walls are visible.
-const VIEW_MARGIN: f32 = 1.04;
-/// Extra room above the arena for the HUD line, as a fraction of the arena height.
-const HUD_BAND: f32 = 0.07;
-
-/// The camera projection and position that show `arena` whole, at its aspect ratio, with a
-/// band above it for the HUD.
-fn view_of(arena: &Arena) -> (Projection, Transform) {
-    let size = arena.size().as_vec2();
-    let projection = Projection::Orthographic(OrthographicProjection {
-        // AutoMin keeps the whole arena visible at its own aspect ratio whatever the window.
-        scaling_mode: ScalingMode::AutoMin {
-            min_width: size.x * VIEW_MARGIN,
-            min_height: size.y * (VIEW_MARGIN + HUD_BAND),
-        },
-        ..OrthographicProjection::default_2d()
-    });
-    // Shift the view up by half the HUD band so the band sits above the arena.
-    let centre = arena.center().as_vec2() + Vec2::Y * size.y * HUD_BAND / 2.0;
-    (projection, Transform::from_translation(centre.extend(0.0)))
-}
-
 fn spawn_camera_and_arena(mut commands: Commands, arena: Res<Arena>) {
-    let (projection, transform) = view_of(&arena);
+    let (projection, transform) = view::view_of(&arena, Vec2::ONE, None);
     commands.spawn((Camera2d, projection, transform));
     commands.spawn((
         ArenaBackdrop,
@@ -120,15 +101,11 @@ fn spawn_camera_and_arena(mut commands: Commands, arena: Res<Arena>) {
 
 type BackdropParts = (&'static mut Sprite, &'static mut Transform);
 
-/// Follows a changed arena (a reloaded scene): camera and backdrop.
-fn fit_view_to_arena(
+/// Follows a changed arena (a reloaded scene) with the backdrop; `view` refits the camera.
+fn fit_backdrop_to_arena(
     arena: Res<Arena>,
-    mut camera: Single<(&mut Projection, &mut Transform), With<Camera2d>>,
-    mut backdrop: Single<BackdropParts, (With<ArenaBackdrop>, Without<Camera2d>)>,
+    mut backdrop: Single<BackdropParts, With<ArenaBackdrop>>,
 ) {
-    let (projection, transform) = view_of(&arena);
-    *camera.0 = projection;
-    *camera.1 = transform;
     backdrop.0.custom_size = Some(arena.size().as_vec2());
     backdrop.1.translation = arena.center().as_vec2().extend(-1.0);
 }

@@ -19,6 +19,8 @@ pub mod ui;
 use bevy::prelude::*;
 use bevy_egui::{EguiPlugin, EguiPrimaryContextPass};
 
+use crate::render::view::PanelEdge;
+
 pub use compare::Comparison;
 pub use controls::Control;
 pub use live::{LiveHistory, LiveSample, StepTimer};
@@ -69,6 +71,7 @@ impl Plugin for PanelPlugin {
     fn build(&self, app: &mut App) {
         app.add_plugins((EguiPlugin::default(), PanelStatePlugin { open: self.open }))
             .init_resource::<ui::Drafts>()
+            .init_resource::<PanelEdge>()
             .add_systems(EguiPrimaryContextPass, ui::draw_panel);
     }
 }

@@ -7,7 +7,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, egui};
-use egui_plot::{Legend, Line, Plot};
+use egui_plot::{AxisHints, GridInput, GridMark, Legend, Line, Plot};
 
 use super::PanelOpen;
 use super::compare::{COMPARE_SECONDS, Comparison};
@@ -16,6 +16,7 @@ use super::live::{LiveHistory, LiveSample};
 use crate::base::config::{Effects, Solver};
 use crate::game::diagnostics::CircleDiagnostics;
 use crate::render::input::MAX_COUNT;
+use crate::render::view::PanelEdge;
 use crate::tools::accuracy::Row;
 
 /// Slider values being dragged: a change that respawns is sent when the drag ends.
@@ -36,17 +37,18 @@ pub struct Settings<'w> {
 
 /// Each solver's colour in the plots (as in the accuracy figure, lighter for exact on the dark
 /// panel), in the order of [`Solver::APP_CHOICES`].
-const COLOURS: [[u8; 3]; 4] = [
+const COLOURS: [[u8; 3]; Solver::APP_CHOICES.len()] = [
     [215, 48, 39],
     [35, 139, 69],
     [33, 113, 181],
     [160, 120, 230],
+    [253, 141, 60],
 ];
 
-/// Draws the panel when it is shown.
+/// Draws the panel when it is shown, and notes where its left edge is.
 pub fn draw_panel(
     mut contexts: EguiContexts,
-    open: Res<PanelOpen>,
+    (open, mut edge): (Res<PanelOpen>, ResMut<PanelEdge>),
     history: Res<LiveHistory>,
     comparison: Res<Comparison>,
     settings: Settings,
@@ -54,11 +56,12 @@ pub fn draw_panel(
     mut controls: MessageWriter<Control>,
 ) -> Result {
     if !open.0 {
+        edge.set_if_neq(PanelEdge(None));
         return Ok(());
     }
     let ctx = contexts.ctx_mut()?;
     let mut sent = Vec::new();
-    egui::Window::new("moving circles  (p: hide)")
+    let shown = egui::Window::new("moving circles  (p: hide)")
         .anchor(egui::Align2::RIGHT_TOP, [-6.0, 6.0])
         .default_width(330.0)
         .resizable(false)
@@ -78,6 +81,9 @@ pub fn draw_panel(
                     comparison_section(ui, &comparison, &mut sent);
                 });
         });
+    // Whole points, so the view is not fitted again for a fraction of a pixel.
+    let left = shown.map(|window| window.response.rect.left().floor());
+    edge.set_if_neq(PanelEdge(left));
     controls.write_batch(sent);
     Ok(())
 }
@@ -182,17 +188,28 @@ fn plots(ui: &mut egui::Ui, history: &LiveHistory) {
         ("pressure z", |s| s.z),
         ("energy drift", |s| Some(s.energy_drift)),
     ];
+    let count = measures.len();
     for (k, (title, value)) in measures.into_iter().enumerate() {
         ui.label(title);
+        // Labels closer than egui_plot's default (20 px), so a short plot shows two or three;
+        // the time axis once, under the last plot.
+        let y_axis = AxisHints::new_y()
+            .formatter(|mark, _| tick(mark.value))
+            .label_spacing(12.0..=18.0);
+        let last = k + 1 == count;
         let mut plot = Plot::new(title)
-            .height(48.0)
+            .height(if last { 80.0 } else { 58.0 })
             .allow_zoom(false)
             .allow_drag(false)
             .allow_scroll(false)
             .allow_boxed_zoom(false)
             .allow_double_click_reset(false)
-            .show_axes([false, true])
-            .y_axis_formatter(|mark, _| tick(mark.value));
+            .show_axes([last, true])
+            .custom_y_axes(vec![y_axis])
+            .y_grid_spacer(round_marks);
+        if last {
+            plot = plot.x_axis_label("simulated s");
+        }
         if k == 0 {
             plot = plot.legend(Legend::default());
         }
@@ -225,6 +242,38 @@ fn runs(
         }
     }
     runs
+}
+
+/// Grid marks at the largest round step (1, 2 or 5 times a power of ten) that puts at least
+/// two of them (and at most five) across the plot's range, so a short plot labels more than one
+/// value.
+fn round_marks(input: GridInput) -> Vec<GridMark> {
+    let (lo, hi) = input.bounds;
+    let span = hi - lo;
+    if !(span.is_finite() && span > 0.0) {
+        return Vec::new();
+    }
+    let widest = span / 2.0;
+    let exponent = widest.log10().floor() as i32;
+    let power = 10f64.powi(exponent);
+    let mantissa = [5.0, 2.0, 1.0]
+        .into_iter()
+        .find(|&m| m * power <= widest)
+        .unwrap_or(1.0);
+    let step = mantissa * power;
+    // k · mantissa / 10^-e rather than k · step, so 3 · 0.2 is 0.6 and not 0.6000000000000001.
+    let value = |k: f64| match exponent {
+        e if e < 0 => k * mantissa / 10f64.powi(-e),
+        _ => k * step,
+    };
+    let (first, last) = ((lo / step).ceil(), (hi / step).floor());
+    let count = (last - first + 1.0).clamp(0.0, 8.0) as usize;
+    (0..count)
+        .map(|i| GridMark {
+            value: value(first + i as f64),
+            step_size: step,
+        })
+        .collect()
 }
 
 /// A compact axis label: `1.5e-14`, `0.25`, `7000`.
@@ -295,4 +344,38 @@ fn comparison_table(ui: &mut egui::Ui, rows: &[Row]) {
             ui.end_row();
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn marks(lo: f64, hi: f64) -> Vec<f64> {
+        let input = GridInput {
+            bounds: (lo, hi),
+            base_step_size: (hi - lo) / 100.0,
+        };
+        round_marks(input).into_iter().map(|m| m.value).collect()
+    }
+
+    #[test]
+    fn a_short_plot_gets_two_to_five_round_marks() {
+        assert_eq!(marks(0.9, 2.6), [1.0, 1.5, 2.0, 2.5]);
+        assert_eq!(marks(0.55, 0.95), [0.6, 0.7, 0.8, 0.9]);
+        assert_eq!(marks(12.5, 13.0), [12.6, 12.8, 13.0]);
+        assert_eq!(marks(7100.0, 9300.0), [8000.0, 9000.0]);
+        assert_eq!(marks(-3e-16, 4e-16), [-2e-16, 0.0, 2e-16, 4e-16]);
+        for (lo, hi) in [
+            (0.0, 1.0),
+            (1e-9, 3e-9),
+            (0.31, 0.99),
+            (-50.0, 700.0),
+            (3.0, 3.001),
+        ] {
+            let n = marks(lo, hi).len();
+            assert!((2..=5).contains(&n), "{lo}..{hi}: {n} marks");
+        }
+        assert!(marks(1.0, 1.0).is_empty());
+        assert!(marks(0.0, f64::INFINITY).is_empty());
+    }
 }
