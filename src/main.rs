@@ -199,7 +199,7 @@ struct RunArgs {
     seed: Option<u64>,
     /// Where a scene's circles are spawned (overrides the scene): `random`; `lattice` (a
     /// triangular lattice of equal circles, up to area fraction ~0.88); or `pack` (any radii,
-    /// compressed under the event engine, up to ~0.85).
+    /// compressed under the event engine, up to ~0.85, or ~0.88 for equal circles).
     #[arg(long)]
     placement: Option<Placement>,
     /// Fill this area fraction with a scene's circles (overrides the scene's count).

@@ -45,6 +45,47 @@ use crate::step::schedule::CircleSystems;
 /// Finds what overlaps each sensor after every fixed step, in [`CircleSystems::Sensors`]
 /// (part of [`CirclesPlugins`](crate::CirclesPlugins)), and registers [`CollisionLayers`] and
 /// [`Sensor`] for reflection. A world without sensors runs nothing.
+///
+/// A sensor still moves with its velocity: make it
+/// [`Mass::IMMOVABLE`](crate::base::components::Mass::IMMOVABLE) for a fixed or steered zone.
+/// Its [`SensorOverlaps`] lists the circles its own layers meet, never another sensor; a
+/// circle that left, was despawned or changed layers is an [`OverlapEnded`]. Since overlaps
+/// are those of the state at the end of the step, a zone should be wider than a step's travel.
+/// Spatial queries see sensors like any circle unless their
+/// [`QueryFilter`](crate::game::query::QueryFilter) leaves them out (`excluding_sensors`).
+/// `exact`'s engine sizes its cells only for circles that can meet another, so a wide sensor
+/// does not coarsen them.
+///
+/// `tests/suite/sensors.rs` holds it against brute force under all five solvers: a world with
+/// sensors moves every other circle bit for bit as one without them, and each step's lists
+/// and messages are exactly the brute-force overlaps and their changes. `examples/sensor_zone.rs`
+/// counts the balls through a goal zone and a picky zone on the gold balls' layer, and checks
+/// the counts against the zones' lists and the balls' energy (unchanged: the zones took
+/// nothing).
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use bevy::prelude::*;
+/// use moving_circles::prelude::*;
+///
+/// #[derive(Component)]
+/// struct Goal;
+///
+/// fn spawn_goal(mut commands: Commands) {
+///     commands.spawn((Goal, Radius(1.5), Position(DVec2::ZERO), Mass::IMMOVABLE, Sensor));
+/// }
+///
+/// /// Runs after the step's sensors were looked at.
+/// fn score(mut entered: MessageReader<OverlapStarted>, goals: Query<(), With<Goal>>) {
+///     for m in entered.read().filter(|m| goals.contains(m.sensor)) {
+///         info!("{} entered the goal", m.circle);
+///     }
+/// }
+/// # fn add(app: &mut App) {
+/// #     app.add_systems(Startup, spawn_goal)
+/// #         .add_systems(FixedUpdate, score.after(CircleSystems::Sensors));
+/// # }
+/// ```
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SensorPlugin;
 

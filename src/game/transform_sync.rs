@@ -14,6 +14,31 @@
 //! put, never smeared from the old place: each step's start is read when the step begins, and a
 //! position that is not the one the last step ended at is shown as it is. Circles without a
 //! `Transform` (a headless run's) cost nothing here.
+//!
+//! The copy runs in `RunFixedMainLoopSystems::AfterFixedMainLoop`, with or without the render
+//! plugin, and writes only `x` and `y`: `z`, rotation and scale stay the game's. A
+//! [`Smoothing`] component chooses for one circle, [`DefaultSmoothing`] (or
+//! [`TransformSyncPlugin`]'s `smoothing`) for the rest. A teleport is a position written from
+//! `Update`, or from `FixedUpdate` ordered before
+//! [`CircleSystems::Step`].
+//! `tests/suite/transform_sync.rs` checks all of it headless at 144 frames a second.
+//!
+//! ```
+//! use bevy::math::DVec2;
+//! use bevy::prelude::*;
+//! use moving_circles::prelude::*;
+//!
+//! fn spawn_ball(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>) {
+//!     commands.spawn((
+//!         Radius(0.5),
+//!         Position(DVec2::new(0.0, 2.0)),
+//!         Velocity(DVec2::new(3.0, 0.0)),
+//!         Mesh2d(meshes.add(Circle::new(0.5))), // Mesh2d brings a Transform: it follows the ball
+//!         Smoothing::Extrapolate,               // this one without the step's lag
+//!     ));
+//! }
+//! # bevy::ecs::system::assert_is_system(spawn_ball);
+//! ```
 
 use bevy::math::DVec2;
 use bevy::prelude::*;

@@ -14,6 +14,7 @@ mod collision_layers;
 mod collisions;
 mod dense;
 mod docs_links;
+mod docs_pages;
 mod docs_reference;
 mod drops;
 mod effects;

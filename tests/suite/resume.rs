@@ -164,9 +164,7 @@ fn a_resumed_exact_run_goes_on_with_the_engine_it_kept() {
     use moving_circles::tools::run::Progress;
 
     // Plain circles, and circles of which some have their own restitution: the restored engine
-    // has them too, so the first step finds every circle as the engine has it. (Circles that
-    // gained a component may come in another query order after the resume, which the step's
-    // write-back then sees: the engine is rebuilt for the step after, not this one.)
+    // has them too, so the first step finds every circle as the engine has it.
     let scene = "(arena: (size: (8.0, 6.0), boundary: walls), effects: (restitution: 0.9),
         spawn: (count: 60, radius: (0.1, 0.2), speed: (1.0, 3.0), seed: 3))";
     let config = Scene::parse(scene, "gas.ron")
@@ -380,8 +378,7 @@ fn a_kinematic_circle_and_the_hit_messages_resume_bit_for_bit_under_every_solver
 fn circles_of_their_own_restitution_resume_bit_for_bit_under_every_solver() {
     use moving_circles::prelude::*;
     // A box under gravity, hit messages on: every fourth circle given a restitution of its
-    // own by code as it is made. (Circles given parts of several kinds resume equal to
-    // rounding: see `own::apply`.)
+    // own by code as it is made.
     let scene = "(arena: (size: (8.0, 6.0), boundary: walls),
         effects: (collisions: true, hit_messages: true, restitution: 0.9,
                   gravity: (0.0, -3.0)),

@@ -14,6 +14,8 @@ use super::{MAX_CIRCLES, MassModel};
 
 /// Drops `count` circles of `radius`, one every `every` simulated seconds, at `position` moved
 /// sideways by up to `spread` (seeded), with `velocity`. A drop waits while the spot is taken.
+/// In a scene: `drop: (count: 200, every: 0.1, position: (0.0, 7.4), spread: 0.3, radius: 0.09)`
+/// (the Galton board's, `assets/scenes/galton.ron`).
 #[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[reflect(Resource, Debug)]
 #[serde(default, deny_unknown_fields)]

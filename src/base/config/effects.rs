@@ -12,12 +12,62 @@ use crate::base::range::{MAX_MAGNITUDE, check_vector};
 
 /// The effects a scene calls for. Only these get systems in the schedule: no gravity, no
 /// gravity system; no collisions, no broad phase.
+///
+/// # A circle's own restitution, friction and spin
+///
+/// `restitution` and `wall_restitution`, `friction` and `wall_friction` are the scene's; a
+/// circle's own [`Restitution`](crate::base::components::Restitution) or
+/// [`Friction`](crate::base::components::Friction) takes their place for that circle. Two
+/// restitutions meet as their minimum (the deader surface decides), against circles and walls
+/// alike and under every solver, so the default of 1 never makes a pair bouncier than either
+/// side asks; two friction coefficients meet as `friction_combine` says.
+///
+/// Friction acts under the contact solver `soft`: each contact gets a tangent row (Coulomb: at
+/// most μ times its normal push; a ball on a slope rolls without slipping at (2/3) g sin θ when
+/// μ ≥ tan θ / 3, and slips otherwise) and a rolling row (a torque of at most
+/// `rolling_resistance` times the push times the radius), both warm started and kept in
+/// checkpoints. Each circle turns by its
+/// [`AngularVelocity`](crate::base::components::AngularVelocity) under every solver, as a
+/// uniform disc (m r² / 2) unless it has its own
+/// [`Inertia`](crate::base::components::Inertia); a circle without an `AngularVelocity` never
+/// turns (friction then only slows its sliding). Under `swept` and `exact` hits can be rough
+/// instead (`tangential_restitution`, `wall_tangential_restitution`; the repository's
+/// `docs/physics.md` has the rule); `discrete` and `substeps=N` treat circles as smooth and
+/// turn each at its own constant rate. The report gives the energy of turning
+/// (`rotational_final`, also in `energy_final`) and the angular momentum about the origin. The
+/// app draws a darker radius on each disc, turned by its
+/// [`Rotation`](crate::base::components::Rotation); a game's own sprite reads `Rotation` the
+/// same way (the transform sync leaves a `Transform`'s rotation to the game).
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use bevy::prelude::*;
+/// use moving_circles::prelude::*;
+///
+/// fn spawn_balls(mut commands: Commands) {
+///     // A dead ball: it meets everything with a restitution of 0.2 at most.
+///     commands.spawn((Radius(0.3), Position(DVec2::new(0.0, 3.0)), Restitution(0.2)));
+///     // A ball struck with backspin: under `soft` it skids, then rolls back towards where it
+///     // came from.
+///     commands.spawn((
+///         Radius(0.3),
+///         Position(DVec2::new(-2.0, -4.2)),
+///         Velocity(DVec2::new(3.0, 0.0)),
+///         AngularVelocity(40.0),
+///         Friction(0.4),
+///     ));
+///     // A hollow ring: all its mass at the rim, so it rolls down a slope at half of g sin θ.
+///     commands.spawn((Radius(0.5), Position(DVec2::new(2.0, -4.0)), Inertia(0.5 * 0.5)));
+/// }
+/// # bevy::ecs::system::assert_is_system(spawn_balls);
+/// ```
 #[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[reflect(Resource, Debug)]
 #[serde(default, deny_unknown_fields)]
 pub struct Effects {
     /// Circle-circle collisions, under every solver. Off, circles pass through each other: the
-    /// time-stepped solvers schedule no broad phase, the event-driven ones predict no pair.
+    /// time-stepped solvers schedule no broad phase, the event-driven ones predict no pair,
+    /// `soft` makes no contact between circles.
     pub collisions: bool,
     /// Constant acceleration, e.g. `(0, -9.81)`; `None` schedules no gravity system.
     pub gravity: Option<DVec2>,
@@ -51,8 +101,19 @@ pub struct Effects {
     /// Tangential restitution β between a circle and a wall (arena or segment wall).
     pub wall_tangential_restitution: f64,
     /// Write a [`CircleHit`](crate::base::hits::CircleHit) message per circle-circle impulse and a
-    /// [`WallHit`](crate::base::hits::WallHit) per wall hit, under every solver. Off, nothing is
-    /// recorded.
+    /// [`WallHit`](crate::base::hits::WallHit) per wall hit, under every solver. Off (the
+    /// default), nothing is recorded and no system is added.
+    ///
+    /// `swept` and `exact` write each at its exact event time, in time order; `discrete` and
+    /// `substeps=N` at the end of the (sub)step that resolved it, for every (sub)step a pair
+    /// still overlaps and approaches; `soft` when a contact begins to push (at the step's end,
+    /// `time = dt`), not for each step a resting contact goes on pushing. The messages equal
+    /// the counters (`tests/suite/hits.rs`, every solver): one `CircleHit` per pair collision,
+    /// and the `WallHit`s' `count`s add up to the wall hits (a step that carries a circle across
+    /// the arena and back gives one message that counts every hit). A system with a
+    /// `MessageReader<CircleHit>` (in `Update`, or in `FixedUpdate` after
+    /// [`CircleSystems::Step`](crate::step::schedule::CircleSystems::Step)) sees each hit once;
+    /// the [crate's front page](crate) reads them in a headless app.
     pub hit_messages: bool,
     /// When circles at rest fall asleep (only under gravity: without it nothing rests).
     pub sleep: SleepConfig,

@@ -222,6 +222,31 @@ impl<'de> Deserialize<'de> for Solver {
 
 /// Everything [`CirclesPlugins`](crate::CirclesPlugins) needs, in one value. Scene files
 /// ([`crate::tools::scene`]) are read into this.
+///
+/// # An open arena
+///
+/// A game that wants no enclosing walls takes
+/// [`Boundary::Open`](crate::base::arena::Boundary::Open): circles fly out of the arena's
+/// rectangle and on, and meet each other wherever they are; walls then come from segment walls
+/// and immovable circles. The rectangle is still where random circles are placed and what the
+/// grids cover (segment walls must lie in it): circles far outside it share its edge cells,
+/// which is correct but slower, so size it to where the action mostly is. Under every solver a
+/// circle that leaves flies on undisturbed, a pair meets 12 units past the rectangle's edge, a
+/// V of segment walls holds a ball while another falls away for good, and a checkpoint with
+/// every circle 30 m below the rectangle resumes bit for bit (`tests/suite/open_arena.rs`).
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use moving_circles::prelude::*;
+///
+/// let config = CirclesConfig {
+///     arena: Arena::centered(DVec2::new(40.0, 30.0)).with_boundary(Boundary::Open),
+///     segments: Segments(vec![Segment::new(DVec2::new(-10.0, -5.0), DVec2::new(10.0, -5.0))]),
+///     effects: Effects { gravity: Some(DVec2::new(0.0, -9.81)), ..Effects::default() },
+///     ..CirclesConfig::default()
+/// };
+/// assert!(config.check().is_ok());
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct CirclesConfig {
     /// The arena and its edges.
@@ -236,7 +261,14 @@ pub struct CirclesConfig {
     pub dt: f64,
     /// Circles placed exactly as given, before the random ones.
     pub circles: Vec<CircleState>,
-    /// Segment walls inside the arena (only on an arena with walls).
+    /// Segment walls inside the arena's rectangle (walled or open; a periodic arena takes none).
+    /// Circles bounce off them under every solver with the arena walls' rule
+    /// (`effects.wall_restitution`, combined with a circle's own), turned to the normal at the
+    /// wall's nearest point (at an end: from the end to the centre), so a horizontal or
+    /// vertical segment behaves exactly like an arena wall. `swept` and `exact` hit a face or an
+    /// end at its exact time of impact, so nothing tunnels through a wall of no thickness; a
+    /// discrete step sees only where circles end up, and a circle moving 10 diameters a step
+    /// goes straight through (`tests/suite/segments.rs`). None: no segment system.
     pub segments: Segments,
     /// Circles dropped in one at a time while it runs, if any.
     pub drop: Option<DropConfig>,

@@ -27,7 +27,13 @@
 //! asks nothing pays nothing. Circles spawned, moved or despawned by game code after that
 //! build are seen from the next step on, or at once after [`SpatialQuery::refresh`]. Segment
 //! walls are tested one by one (a scene has at most
-//! [`MAX_SEGMENTS`](crate::base::segment::MAX_SEGMENTS)).
+//! [`MAX_SEGMENTS`](crate::base::segment::MAX_SEGMENTS)). Walls are the arena's four edges when
+//! it has walls, and every segment wall. Shapes are solid: a ray that starts inside a circle
+//! meets it at distance 0. On a periodic arena queries use the minimum image and casts wrap
+//! through the seams, for at most [`PERIODIC_REACH`](index::PERIODIC_REACH) box diagonals.
+//! `tests/suite/queries.rs` checks the index against brute force on 10,000 random scenes
+//! (narrow and decade-wide radii, walled, open and periodic arenas) and `SpatialQuery`, walls
+//! and segments included, on 10,000 more queries.
 
 pub mod index;
 pub mod shapes;
@@ -84,7 +90,28 @@ pub struct CastHit {
     pub normal: DVec2,
 }
 
-/// Which circles and walls a query considers.
+/// Which circles and walls a query considers: circles only, walls only, all but given
+/// entities (the caster), without sensors, or only the circles of some layers.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use bevy::prelude::*;
+/// use moving_circles::prelude::*;
+///
+/// #[derive(Component)]
+/// struct Player;
+///
+/// /// What the player would hit shooting to the right, itself left out.
+/// fn shoot(player: Query<(Entity, &Position), With<Player>>, query: SpatialQuery) {
+///     for (me, at) in &player {
+///         let filter = QueryFilter::default().excluding([me]);
+///         if let Some(hit) = query.ray_cast(at.0, DVec2::X, 20.0, &filter) {
+///             info!("{:?} at {} m, normal {}", hit.target, hit.distance, hit.normal);
+///         }
+///     }
+/// }
+/// # bevy::ecs::system::assert_is_system(shoot);
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct QueryFilter {
     /// Whether circles count.

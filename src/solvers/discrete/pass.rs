@@ -16,9 +16,9 @@ use crate::collision::contact::{combine_restitution, resolve_contact, work_by_im
 use crate::step::bodies::BodyStore;
 use crate::step::boundary::put_back_inside;
 
-/// The circles of one collision pass ([`BodyStore`]), and buffers reused from pass to pass so
-/// the hot path does not allocate: centres and radii together (what the broad phase reads) and
-/// in cell order, and the pairs.
+/// The circles of one collision pass (the step's body store), and buffers reused from pass to
+/// pass so the hot path does not allocate: centres and radii together (what the broad phase
+/// reads) and in cell order, and the pairs.
 #[derive(Default)]
 pub struct ContactScratch {
     pub(crate) bodies: BodyStore,

@@ -51,7 +51,8 @@ pub const RESTING_TIME: f64 = 0.5;
 /// nine times this (more than twice, checked below). At `r` = 0.75 m and `g` = 9.81 it is
 /// 2.8 ms, a sixth of a 60 Hz frame. A hundredth of `√(r/g)` rather than less: a pile of 2000
 /// circles forming makes about five times as many hits at 1e-4 (2.4 million in its first 20 s
-/// against 0.50 million, both at rounding overlap and asleep, `docs/piles.md`).
+/// against 0.50 million, both at rounding overlap and asleep; measured on 2026-12-04,
+/// `docs/history.md`).
 pub const CONTACT_TIME: f64 = 1e-2;
 
 // A bounce at the rest height lasts more than twice the contact time: `(2·√(2h))² = 8h`
