@@ -83,6 +83,10 @@ fn fit_view(
     window: Single<&Window, With<PrimaryWindow>>,
     mut camera: Single<(&mut Projection, &mut Transform), With<Camera2d>>,
 ) {
+    // A minimised window has no size to fit into; it is fitted again when it comes back.
+    if window.width() <= 0.0 || window.height() <= 0.0 {
+        return;
+    }
     let (projection, transform) = view_of(&arena, window.size(), edge.0);
     *camera.0 = projection;
     *camera.1 = transform;

@@ -246,21 +246,21 @@ fn runs(
 
 /// Grid marks at the largest round step (1, 2 or 5 times a power of ten) that puts at least
 /// two of them (and at most five) across the plot's range, so a short plot labels more than one
-/// value.
+/// value; but never closer than egui_plot shows a label (18 pixels apart), where a plot is too
+/// short for two.
 fn round_marks(input: GridInput) -> Vec<GridMark> {
     let (lo, hi) = input.bounds;
     let span = hi - lo;
-    if !(span.is_finite() && span > 0.0) {
+    // `base_step_size` is the value 8 pixels cover.
+    let closest = input.base_step_size * 18.0 / 8.0;
+    if !(span.is_finite() && span > 0.0 && closest.is_finite()) {
         return Vec::new();
     }
-    let widest = span / 2.0;
-    let exponent = widest.log10().floor() as i32;
-    let power = 10f64.powi(exponent);
-    let mantissa = [5.0, 2.0, 1.0]
-        .into_iter()
-        .find(|&m| m * power <= widest)
-        .unwrap_or(1.0);
-    let step = mantissa * power;
+    let (mantissa, exponent) = match round_step_at_most(span / 2.0) {
+        (m, e) if m * 10f64.powi(e) >= closest => (m, e),
+        _ => round_step_at_least(closest),
+    };
+    let step = mantissa * 10f64.powi(exponent);
     // k · mantissa / 10^-e rather than k · step, so 3 · 0.2 is 0.6 and not 0.6000000000000001.
     let value = |k: f64| match exponent {
         e if e < 0 => k * mantissa / 10f64.powi(-e),
@@ -274,6 +274,30 @@ fn round_marks(input: GridInput) -> Vec<GridMark> {
             step_size: step,
         })
         .collect()
+}
+
+/// The largest round step (`mantissa` 1, 2 or 5 times 10^`exponent`) no wider than `widest`.
+fn round_step_at_most(widest: f64) -> (f64, i32) {
+    let exponent = widest.log10().floor() as i32;
+    let power = 10f64.powi(exponent);
+    let mantissa = [5.0, 2.0, 1.0]
+        .into_iter()
+        .find(|&m| m * power <= widest)
+        .unwrap_or(1.0);
+    (mantissa, exponent)
+}
+
+/// The smallest round step no narrower than `narrowest`.
+fn round_step_at_least(narrowest: f64) -> (f64, i32) {
+    let exponent = narrowest.log10().floor() as i32;
+    let power = 10f64.powi(exponent);
+    match [1.0, 2.0, 5.0]
+        .into_iter()
+        .find(|&m| m * power >= narrowest)
+    {
+        Some(m) => (m, exponent),
+        None => (1.0, exponent + 1),
+    }
 }
 
 /// A compact axis label: `1.5e-14`, `0.25`, `7000`.
@@ -350,12 +374,17 @@ fn comparison_table(ui: &mut egui::Ui, rows: &[Row]) {
 mod tests {
     use super::*;
 
-    fn marks(lo: f64, hi: f64) -> Vec<f64> {
+    /// The marks of a plot showing `lo..hi` over `pixels` pixels.
+    fn marks_over(lo: f64, hi: f64, pixels: f64) -> Vec<f64> {
         let input = GridInput {
             bounds: (lo, hi),
-            base_step_size: (hi - lo) / 100.0,
+            base_step_size: (hi - lo) * 8.0 / pixels,
         };
         round_marks(input).into_iter().map(|m| m.value).collect()
+    }
+
+    fn marks(lo: f64, hi: f64) -> Vec<f64> {
+        marks_over(lo, hi, 800.0)
     }
 
     #[test]
@@ -375,6 +404,10 @@ mod tests {
             let n = marks(lo, hi).len();
             assert!((2..=5).contains(&n), "{lo}..{hi}: {n} marks");
         }
+        // A 40-pixel plot keeps its labels 18 pixels apart: fewer, wider steps.
+        assert_eq!(marks_over(0.55, 0.95, 64.0), [0.6, 0.8]);
+        assert_eq!(marks_over(0.0, 1.0, 40.0), [0.0, 0.5, 1.0]);
+        assert_eq!(marks_over(0.0, 1.0, 30.0), [0.0, 1.0]);
         assert!(marks(1.0, 1.0).is_empty());
         assert!(marks(0.0, f64::INFINITY).is_empty());
     }
