@@ -1,7 +1,7 @@
 //! The windowed app's side (cargo feature `render`): a camera that keeps the whole arena in view
-//! at its aspect ratio ([`view`]), one sprite per circle sharing a single disc texture (so thousands draw
-//! in a handful of batched draw calls, each with its own tint; a darker radius on the disc
-//! turns with the circle's [`Rotation`]), a thin bar per segment wall, and
+//! at its aspect ratio ([`view`]), one sprite per circle sharing a single disc texture (so
+//! thousands draw in a handful of batched draw calls, each with its own tint; a darker radius
+//! on the disc turns with the circle's [`Rotation`]), a thin bar per segment wall, and
 //! the [`hud`], [`input`] and [`screenshot`] plugins; the app adds the live [`panel`]. The
 //! simulation never reads anything from here; the core group's
 //! [`transform_sync`](crate::game::transform_sync) moves the sprites.
@@ -85,23 +85,20 @@ fn create_disc_texture(mut commands: Commands, mut images: ResMut<Assets<Image>>
     commands.insert_resource(DiscTexture(images.add(image)));
 }
 
-fn spawn_camera_and_arena(mut commands: Commands, arena: Res<Arena>) {
-    let (projection, transform) = view::view_of(&arena, Vec2::ONE, None);
-    commands.spawn((Camera2d, projection, transform));
+/// The camera and the arena's backdrop; both are fitted to the arena on the first update
+/// (`view`'s `fit_view`, [`fit_backdrop_to_arena`]), as whenever it changes.
+fn spawn_camera_and_arena(mut commands: Commands) {
+    commands.spawn(Camera2d);
     commands.spawn((
         ArenaBackdrop,
-        Sprite {
-            color: Color::srgb(0.09, 0.1, 0.14),
-            custom_size: Some(arena.size().as_vec2()),
-            ..default()
-        },
-        Transform::from_translation(arena.center().as_vec2().extend(-1.0)),
+        Sprite::from_color(Color::srgb(0.09, 0.1, 0.14), Vec2::ONE),
     ));
 }
 
 type BackdropParts = (&'static mut Sprite, &'static mut Transform);
 
-/// Follows a changed arena (a reloaded scene) with the backdrop; `view` refits the camera.
+/// Sizes and places the backdrop on the arena: at the start and after a change (a reloaded
+/// scene); `view` fits the camera.
 fn fit_backdrop_to_arena(
     arena: Res<Arena>,
     mut backdrop: Single<BackdropParts, With<ArenaBackdrop>>,

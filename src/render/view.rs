@@ -20,7 +20,7 @@ const LEAST_SHARE: f32 = 0.3;
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct PanelEdge(pub Option<f32>);
 
-/// Fits the camera to the arena when it starts and whenever the arena, the panel or the
+/// Fits the camera to the arena on the first update and whenever the arena, the panel or the
 /// window changes.
 pub(crate) struct ViewPlugin;
 
@@ -40,7 +40,7 @@ impl Plugin for ViewPlugin {
 /// The camera's projection and position that show `arena` whole, at its aspect ratio, with a
 /// band above it for the HUD: in the whole window while `free` (the width left of the panel,
 /// in logical pixels of a `window`-sized window) is `None`, else in its left `free` pixels.
-pub(crate) fn view_of(arena: &Arena, window: Vec2, free: Option<f32>) -> (Projection, Transform) {
+fn view_of(arena: &Arena, window: Vec2, free: Option<f32>) -> (Projection, Transform) {
     let size = arena.size().as_vec2();
     let (wide, high) = (size.x * VIEW_MARGIN, size.y * (VIEW_MARGIN + HUD_BAND));
     // Up by half the band, so the band sits above the arena.
