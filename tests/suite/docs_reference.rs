@@ -250,13 +250,7 @@ fn flags_in(help: &str) -> BTreeSet<String> {
 /// benchmarks' README.
 fn guide_pages() -> Vec<std::path::PathBuf> {
     let mut pages = vec!["README.md".into(), "benches/README.md".into()];
-    for entry in std::fs::read_dir("docs").unwrap() {
-        let path = entry.unwrap().path();
-        let history = path.file_name().is_some_and(|n| n == "history.md");
-        if path.extension().is_some_and(|e| e == "md") && !history {
-            pages.push(path);
-        }
-    }
+    pages.extend(crate::docs_pages::reference_pages());
     pages
 }
 
